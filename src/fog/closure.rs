@@ -1,0 +1,200 @@
+//! The closure step: everything the 12.5 kHz interrupt does for the FOG.
+//!
+//! Batch processing as in quartiq's stabilizer: the interrupt hands over the ADC
+//! samples of step k (taken while the DAC words of step k were applied) and gets
+//! back the DAC words of step k+1. The immutable [`FogConfig`] is passed in; all
+//! mutable state lives in [`FogLoop`].
+
+use super::config::FogConfig;
+use super::demod::demodulate;
+use super::faults::Faults;
+use super::gain_loop;
+use super::modulator::{Modulator, Resets};
+use super::vibration::VibrationCorrection;
+use super::MAX_HALF;
+
+/// What one closure step produces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ClosureOutput {
+    /// Sagnac phase measured over this step (feedback step applied plus the
+    /// demodulated residual), phase LSB (2*pi/2^32 rad; rate = step *
+    /// RAD_PER_PHASE_LSB / K_s). Not wrapped: it counts whole fringes beyond +-pi.
+    pub step: i64,
+    /// `step` less the epsilon-squared bias estimate (equal to `step` when off).
+    pub step_corrected: i64,
+    /// Demodulated mean residual of this step, phase LSB.
+    pub residual: i32,
+    /// Digital modulator gain (DAC codes per turn, Q8) from the 2*pi loop.
+    pub codes_per_turn_q8: u32,
+    /// Detector DC, kept-sample sum of one half period, ADC LSB.
+    pub dc: u32,
+    pub faults: Faults,
+}
+
+/// Mutable state of one FOG channel.
+#[derive(Clone, Copy, Debug)]
+pub struct FogLoop {
+    /// Integrator: feedback step, phase LSB, unwrapped.
+    step: i64,
+    /// Digital gain, DAC codes per turn in Q8.
+    cpt_q8: u32,
+    /// Low-passed DC of one half period, ADC LSB in Q12; time constant 4096 steps
+    /// (0.33 s). Slow on purpose: a step's DC has a first-order term in the
+    /// in-step residual slope (proportional to eps), so a fast AGC would modulate
+    /// the loop gain at the vibration frequency and rectify a second eps^2 drift.
+    dc_q12: u64,
+    /// The DC filter holds a measured value (seeded on the first good step).
+    dc_valid: bool,
+    modulator: Modulator,
+    /// Resets of the DAC words now being applied (measured in the next call).
+    pending_resets: Resets,
+    vibration: VibrationCorrection,
+    halves: [u32; MAX_HALF],
+    unlocked_steps: u16,
+    faults: Faults,
+    /// xorshift32 state of the depth dither.
+    dither: u32,
+}
+
+/// Feedback-step clamp: +-2^40 LSB is +-256 turns, about +-1200 rad/s at K_s = 1.35 s.
+const STEP_LIMIT: i64 = 1 << 40;
+
+impl FogLoop {
+    pub fn new(cfg: &FogConfig) -> Self {
+        Self {
+            step: 0,
+            cpt_q8: cfg.cpt_nominal_q8,
+            dc_q12: (cfg.h0_nominal as u64) << 12,
+            dc_valid: false,
+            modulator: Modulator::default(),
+            pending_resets: Resets::default(),
+            vibration: VibrationCorrection::default(),
+            halves: [0; MAX_HALF],
+            unlocked_steps: 0,
+            faults: Faults::default(),
+            dither: 0x9E37_79B9,
+        }
+    }
+
+    /// Writes the first step's DAC words (before any ADC data exists).
+    pub fn start(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
+        let n = cfg.n_half.min(dac.len());
+        if let Some(dac) = dac.get_mut(..n) {
+            let depth = self.next_depth(cfg);
+            self.pending_resets =
+                self.modulator
+                    .write_step(self.step as u32, depth, self.cpt_q8, dac);
+        }
+    }
+
+    /// phi0 plus a uniform dither in [-2^(dither_bits-1), 2^(dither_bits-1)) LSB.
+    #[inline(always)]
+    fn next_depth(&mut self, cfg: &FogConfig) -> u32 {
+        let mut x = self.dither;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.dither = x;
+        let r = (x as i32).checked_shr(32 - cfg.dither_bits).unwrap_or(0); // bits = 0: off
+        cfg.phi0.wrapping_add_signed(r)
+    }
+
+    /// One closure step. `adc`: `cfg.n_samples` samples of the step just applied;
+    /// `dac`: receives `cfg.n_half` words for the next step. Never panics: short
+    /// buffers are treated as a saturated (discarded) step.
+    pub fn process(&mut self, cfg: &FogConfig, adc: &[u16], dac: &mut [u16]) -> ClosureOutput {
+        let n_half = cfg.n_half;
+        let (Some(adc), Some(dac), Some(halves)) = (
+            adc.get(..cfg.n_samples),
+            dac.get_mut(..n_half),
+            self.halves.get_mut(..n_half),
+        ) else {
+            self.faults.set(Faults::ADC_SATURATION, true);
+            return self.output(self.step, 0, 0, 0);
+        };
+        let sums = demodulate(adc, cfg.samples_per_half, cfg.skip_samples, halves);
+        let h_step = sums.dc / n_half as u32;
+        let power_low = h_step < cfg.h0_min;
+        self.faults.set(Faults::OPTICAL_POWER_LOW, power_low);
+        self.faults.set(Faults::ADC_SATURATION, sums.saturated);
+
+        let mut residual = 0i64;
+        let mut bias = 0i64;
+        // Sagnac phase measured over this step: applied step plus residual.
+        let mut measured = self.step;
+        if power_low || sums.saturated {
+            // Safe path: hold the step and the gain; the output keeps integrating
+            // the last good rate (flagged); AGC and correction restart afterwards.
+            self.vibration.reset();
+            self.dc_valid = false;
+        } else {
+            // Slow AGC: normalise by a low-passed DC so the loop gain does not depend
+            // on optical power, without correlating the gain with this step's error.
+            if self.dc_valid {
+                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step as u64;
+            } else {
+                self.dc_q12 = (h_step as u64) << 12;
+                self.dc_valid = true;
+            }
+            let h = ((self.dc_q12 >> 12) as u32).max(1);
+            let recip_h = u32::MAX / h; // 2^32 / H
+                                        // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H.
+            let kn = ((cfg.k_meas_q8 * recip_h as u64) >> 24) as i64;
+            // |sum| < 2^22, kn < 2^31 (H >= h0_min): products below 2^53.
+            residual = (-(sums.first as i64 + sums.second as i64) * kn) >> 16;
+            let slope = ((2 * (sums.first as i64 - sums.second as i64) * kn) >> 24)
+                .clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+
+            measured = self.step + residual;
+            self.step =
+                (self.step + ((residual * cfg.loop_gain_q16) >> 16)).clamp(-STEP_LIMIT, STEP_LIMIT);
+
+            let err = gain_loop::reset_error(halves, self.pending_resets, sums.dc);
+            self.cpt_q8 = gain_loop::update(
+                self.cpt_q8,
+                err,
+                cfg.gain_loop_q16,
+                recip_h,
+                cfg.cpt_min_q8,
+                cfg.cpt_max_q8,
+            );
+
+            if cfg.vibration_correction {
+                bias = self.vibration.update(slope, cfg.vib_coeff, cfg.vib_shift);
+            }
+            let unlocked = residual.unsigned_abs() > cfg.lock_limit as u64;
+            self.unlocked_steps = if unlocked {
+                self.unlocked_steps.saturating_add(1)
+            } else {
+                0
+            };
+            if self.unlocked_steps >= cfg.lock_steps {
+                self.faults.set(Faults::OUT_OF_LOCK, true);
+            } else if self.unlocked_steps == 0 {
+                self.faults.set(Faults::OUT_OF_LOCK, false);
+            }
+        }
+        let out = self.output(measured, residual, bias, h_step);
+        let depth = self.next_depth(cfg);
+        self.pending_resets = self
+            .modulator
+            .write_step(self.step as u32, depth, self.cpt_q8, dac);
+        out
+    }
+
+    fn output(&self, measured: i64, residual: i64, bias: i64, dc: u32) -> ClosureOutput {
+        ClosureOutput {
+            step: measured,
+            step_corrected: measured - bias,
+            residual: residual.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            codes_per_turn_q8: self.cpt_q8,
+            dc,
+            faults: self.faults,
+        }
+    }
+
+    /// Current feedback step, phase LSB.
+    pub fn step(&self) -> i64 {
+        self.step
+    }
+}

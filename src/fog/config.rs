@@ -1,0 +1,243 @@
+//! Immutable loop configuration: physical parameters in, fixed-point constants out.
+//! Built once (host or MCU start-up, floating point allowed); the interrupt only
+//! reads it.
+
+use super::{MAX_HALF, MAX_SAMPLES_PER_HALF};
+use crate::{phase_from_rad, Phase};
+use core::f64::consts::{PI, TAU};
+use num_traits::float::Float;
+
+/// Speed of light in vacuum, m/s.
+pub const C_LIGHT: f64 = 299_792_458.0;
+
+/// Physical and design parameters of one FOG channel (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FogParams {
+    /// Fiber length L, m.
+    pub fiber_length_m: f64,
+    /// Coil diameter D, m.
+    pub coil_diameter_m: f64,
+    /// Source mean wavelength, m.
+    pub wavelength_m: f64,
+    /// Half period tau (coil transit time; modulation at the proper frequency), s.
+    pub tau_s: f64,
+    /// Bias modulation depth phi0, rad (the phase difference alternates +-phi0).
+    pub phi0_rad: f64,
+    /// Closure rate, Hz. Must give a whole, even number of half periods.
+    pub closure_hz: f64,
+    /// ADC samples per half period.
+    pub samples_per_half: usize,
+    /// Samples skipped after each modulation edge (detector transient).
+    pub skip_samples: usize,
+    /// Main-loop gain: fraction of the measured residual corrected per step.
+    pub loop_gain: f64,
+    /// 2*pi gain-loop gain: fraction of a measured gain error corrected per reset.
+    pub gain_loop_gain: f64,
+    /// DAC codes that give 2*pi at the modulator at nominal V_pi.
+    pub dac_codes_per_turn: u32,
+    /// Depth dither: uniform over 2^dither_bits phase LSB (0 = off); 25 bits is
+    /// +-0.025 rad, several ADC LSB of detector level.
+    pub dither_bits: u32,
+    /// Online epsilon-squared correction on.
+    pub vibration_correction: bool,
+    /// Expected DC level of one kept ADC sample at the operating point, LSB
+    /// (sets the optical-power-low threshold and the start-up normalisation).
+    pub nominal_dc_lsb: f64,
+}
+
+impl Default for FogParams {
+    /// The reference instrument of physics.md 1.4: L = 1000 m, D = 0.1 m,
+    /// 1.55 um, tau = 5 us, phi0 = 3*pi/4, closure 12.5 kHz.
+    fn default() -> Self {
+        Self {
+            fiber_length_m: 1000.0,
+            coil_diameter_m: 0.1,
+            wavelength_m: 1.55e-6,
+            tau_s: 5e-6,
+            phi0_rad: 0.75 * PI,
+            closure_hz: 12_500.0,
+            samples_per_half: 4,
+            skip_samples: 1,
+            loop_gain: 1.0,
+            gain_loop_gain: 0.05,
+            dac_codes_per_turn: 49_152,
+            dither_bits: 25,
+            vibration_correction: true,
+            nominal_dc_lsb: 8_000.0,
+        }
+    }
+}
+
+/// Why a parameter set was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigError {
+    /// Closure period is not a whole, even number of half periods, or too many.
+    HalfPeriods,
+    /// Samples per half period or skipped samples out of range.
+    Samples,
+    /// phi0 outside (0, pi).
+    Phi0,
+    /// Loop gain outside (0, 2) (the one-step integrator is unstable beyond).
+    LoopGain,
+    /// DAC codes per turn leave no headroom for the 2*pi loop in 16 bits.
+    DacRange,
+    /// Non-finite or non-positive physical parameter.
+    Physical,
+}
+
+/// Fixed-point constants derived from [`FogParams`]; read-only in the interrupt.
+#[derive(Clone, Copy, Debug)]
+pub struct FogConfig {
+    /// The physical parameters this was built from.
+    pub params: FogParams,
+    /// Sagnac scale factor K_s = 2*pi*L*D/(lambda*c), rad per rad/s.
+    pub k_sagnac_s: f64,
+    /// Half periods per closure step (16 at 12.5 kHz).
+    pub n_half: usize,
+    /// ADC samples per closure step.
+    pub n_samples: usize,
+    /// Samples per half period and samples skipped after each edge.
+    pub samples_per_half: usize,
+    pub skip_samples: usize,
+    /// phi0 as [`Phase`] LSB.
+    pub phi0: Phase,
+    /// Residual per normalised demodulator count: `cot(phi0/2) * 2^32/(2*pi*n_half)`
+    /// in Q8 (phase LSB * 2^8 per unit of sum(sign*h)/H0).
+    pub k_meas_q8: u64,
+    /// Main-loop gain in Q16 (65 536 = unit gain).
+    pub loop_gain_q16: i64,
+    /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error, Q16.
+    pub gain_loop_q16: i64,
+    /// Nominal DAC codes per turn, Q8.
+    pub cpt_nominal_q8: u32,
+    /// Clamp of the digital gain (codes per turn, Q8).
+    pub cpt_min_q8: u32,
+    pub cpt_max_q8: u32,
+    /// Epsilon-squared correction: output bias (phase LSB, Q16) per product of two
+    /// in-step residual slopes, each in units of 2^8 phase LSB; scaled by 2^-`vib_shift`.
+    pub vib_coeff: i64,
+    pub vib_shift: u32,
+    pub vibration_correction: bool,
+    /// Depth dither width, bits (0 = off, at most 30).
+    pub dither_bits: u32,
+    /// Kept-sample sum of one half period at the nominal operating point, LSB.
+    pub h0_nominal: u32,
+    /// Below this DC (per-half sum) the optical power is flagged low.
+    pub h0_min: u32,
+    /// Residual beyond which a step counts toward loss of lock, phase LSB.
+    pub lock_limit: u32,
+    /// Consecutive steps beyond `lock_limit` that declare loss of lock.
+    pub lock_steps: u16,
+}
+
+impl FogConfig {
+    pub fn new(p: FogParams) -> Result<Self, ConfigError> {
+        let finite_pos = |x: f64| x.is_finite() && x > 0.0;
+        if !(finite_pos(p.fiber_length_m)
+            && finite_pos(p.coil_diameter_m)
+            && finite_pos(p.wavelength_m)
+            && finite_pos(p.tau_s)
+            && finite_pos(p.closure_hz)
+            && finite_pos(p.nominal_dc_lsb))
+        {
+            return Err(ConfigError::Physical);
+        }
+        let halves = 1.0 / (p.closure_hz * p.tau_s);
+        let n_half = halves.round() as usize;
+        if (halves - n_half as f64).abs() > 1e-6
+            || n_half < 2
+            || n_half % 2 != 0
+            || n_half > MAX_HALF
+        {
+            return Err(ConfigError::HalfPeriods);
+        }
+        if p.samples_per_half == 0
+            || p.samples_per_half > MAX_SAMPLES_PER_HALF
+            || p.skip_samples >= p.samples_per_half
+        {
+            return Err(ConfigError::Samples);
+        }
+        if !(p.phi0_rad > 0.0 && p.phi0_rad < PI) {
+            return Err(ConfigError::Phi0);
+        }
+        if !(p.loop_gain > 0.0 && p.loop_gain < 2.0)
+            || !(p.gain_loop_gain >= 0.0 && p.gain_loop_gain < 1.0)
+        {
+            return Err(ConfigError::LoopGain);
+        }
+        // The 2*pi loop may raise the gain by up to 25 %: keep that inside 16 bits.
+        if p.dac_codes_per_turn < 1024 || p.dac_codes_per_turn as f64 * 1.25 > 65_535.0 {
+            return Err(ConfigError::DacRange);
+        }
+        let k_sagnac_s = TAU * p.fiber_length_m * p.coil_diameter_m / (p.wavelength_m * C_LIGHT);
+        let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
+        let lsb_per_rad = 4_294_967_296.0 / TAU;
+        let k_meas = cot_half * lsb_per_rad / n_half as f64;
+        let kept = (p.samples_per_half - p.skip_samples) as f64;
+        let h0_nominal = p.nominal_dc_lsb * kept;
+
+        // Epsilon-squared correction, derived in vibration.rs:
+        // d = -(2*cot(phi0)/(g*n_half)) * da * db  [rad], da, db in rad.
+        // With da, db in units of 2^8 LSB and d in LSB*2^16:
+        // d_q16 = coeff_real * da' * db', coeff_real = -(2 cot phi0/(g n)) * 2^16 * 2^16 * LSB_rad.
+        let cot_phi0 = 1.0 / p.phi0_rad.tan();
+        let coeff_real = -(2.0 * cot_phi0 / (p.loop_gain * n_half as f64))
+            * 65_536.0
+            * 65_536.0
+            * crate::RAD_PER_PHASE_LSB;
+        let vib_shift = 24;
+        let vib_coeff = (coeff_real * (1u64 << vib_shift) as f64).round() as i64;
+
+        let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU;
+        Ok(Self {
+            params: p,
+            k_sagnac_s,
+            n_half,
+            n_samples: n_half * p.samples_per_half,
+            samples_per_half: p.samples_per_half,
+            skip_samples: p.skip_samples,
+            phi0: phase_from_rad(p.phi0_rad),
+            k_meas_q8: (k_meas * 256.0).round() as u64,
+            loop_gain_q16: (p.loop_gain * 65_536.0).round() as i64,
+            gain_loop_q16: (gain_loop * 65_536.0).round() as i64,
+            cpt_nominal_q8: p.dac_codes_per_turn << 8,
+            cpt_min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
+            cpt_max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
+            vib_coeff,
+            vib_shift,
+            vibration_correction: p.vibration_correction,
+            dither_bits: p.dither_bits.min(30),
+            h0_nominal: h0_nominal.round() as u32,
+            h0_min: (h0_nominal * 0.25).round() as u32,
+            lock_limit: phase_from_rad(0.5 * PI),
+            lock_steps: 8,
+        })
+    }
+
+    /// Closure period dt_p, s.
+    pub fn closure_period_s(&self) -> f64 {
+        self.n_half as f64 * self.params.tau_s
+    }
+
+    /// Rate (rad/s) of one phase LSB of the feedback step.
+    pub fn rad_s_per_step_lsb(&self) -> f64 {
+        crate::RAD_PER_PHASE_LSB / self.k_sagnac_s
+    }
+
+    /// Angle (rad) of one unit of the angle-increment word (one step LSB held
+    /// for one half period).
+    pub fn rad_per_angle_lsb(&self) -> f64 {
+        self.rad_s_per_step_lsb() * self.params.tau_s
+    }
+
+    /// Predicted epsilon-squared drift of this loop, rad/s, for mean eps^2 (rad/s^2)^2
+    /// in the quasi-static limit (vibration well below the loop bandwidth):
+    /// `-(cot(phi0)/2) * K_s * tau * (dt_p/g) * <eps^2>`; for unit gain this is
+    /// physics.md's `-(1/4) cot(phi0) K_s eps^2 dt_m dt_p`.
+    pub fn predicted_vibration_drift(&self, mean_eps_sq: f64) -> f64 {
+        let p = &self.params;
+        -(1.0 / p.phi0_rad.tan()) / 2.0 * self.k_sagnac_s * p.tau_s * self.closure_period_s()
+            / p.loop_gain
+            * mean_eps_sq
+    }
+}

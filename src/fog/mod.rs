@@ -1,0 +1,25 @@
+//! Closed-loop fiber-optic gyro: square-wave +-phi0 bias modulation, synchronous
+//! demodulation, digital serrodyne feedback, the 2*pi gain loop and the online
+//! epsilon-squared (vibration rectification) correction. See physics.md section 1.
+//!
+//! Data flow per closure step (one interrupt, `n_half` half periods of tau):
+//! ADC batch -> [`demod`] -> main loop ([`closure`]) and [`gain_loop`] ->
+//! [`modulator`] writes the DAC words of the next step; [`vibration`] corrects
+//! the output; [`faults`] flags what went wrong.
+
+pub mod closure;
+pub mod config;
+pub mod demod;
+pub mod faults;
+pub mod gain_loop;
+pub mod modulator;
+pub mod vibration;
+
+pub use closure::{ClosureOutput, FogLoop};
+pub use config::{FogConfig, FogParams};
+pub use faults::Faults;
+
+/// Most half periods per closure step (6.25 kHz closure at tau = 5 us is 32).
+pub const MAX_HALF: usize = 64;
+/// Most ADC samples per half period.
+pub const MAX_SAMPLES_PER_HALF: usize = 16;

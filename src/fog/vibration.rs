@@ -1,0 +1,52 @@
+//! Online correction of the epsilon-squared (vibration rectification) drift.
+//!
+//! Derivation for this loop (physics.md 1.4): within a step the residual grows by
+//! b = K_s*eps*tau per half period. The cosine's second-order term adds
+//! `(cot(phi0)/4)*(d1^2 - d2^2)` to each (+phi0, -phi0) pair, which summed over a
+//! step starting on +phi0 gives a demodulated bias `-(cot(phi0)/2)*b*dbar`
+//! (dbar = mean residual of the step). The integrator nulls the mean demodulated
+//! error, so the output carries that bias. For a one-step integrator of gain g the
+//! quasi-static residual is dbar = n*b/g (n half periods per step), so
+//! `bias = -(cot(phi0)/2)*(n/g)*b^2` [rad per step]; with g = 1 this is
+//! physics.md's `-(1/4)*cot(phi0)*K_s*eps^2*dt_m*dt_p`.
+//!
+//! b is measured in the step itself: the residual of the second half of the step
+//! minus that of the first half, `da = (n/2)*b`. Squaring one noisy da would be
+//! biased by its noise variance; the product of da from this step and from the
+//! previous one (disjoint noise) is unbiased, so the correction adds no drift at
+//! rest. Its only lag is one step: the mean of the product is eps^2*cos(w*dt_p).
+//! `bias = -(2*cot(phi0)/(g*n)) * da_k * da_(k-1)`.
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VibrationCorrection {
+    /// In-step residual slope of the previous step, 2^8 phase LSB.
+    prev_slope: i32,
+    /// Sub-LSB part of the correction carried to the next step (phase LSB, Q16).
+    frac_q16: i64,
+}
+
+/// Slopes are saturated here (2^8 LSB units, about 0.37 rad): beyond that the
+/// loop is not tracking and the correction is meaningless.
+const SLOPE_LIMIT: i32 = 1 << 20;
+
+impl VibrationCorrection {
+    /// Takes this step's slope (2^8 LSB) and returns the bias to subtract from
+    /// the output step, whole phase LSB (the fraction is carried, no loss).
+    #[inline(always)]
+    pub fn update(&mut self, slope: i32, coeff: i64, shift: u32) -> i64 {
+        let slope = slope.clamp(-SLOPE_LIMIT, SLOPE_LIMIT);
+        // |product| < 2^40, |coeff| < 2^23 at any phi0 in (0.1, pi-0.1): < 2^63.
+        let product = slope as i64 * self.prev_slope as i64;
+        self.prev_slope = slope;
+        let bias_q16 = product.saturating_mul(coeff) >> shift;
+        let total = self.frac_q16 + bias_q16;
+        let whole = total >> 16;
+        self.frac_q16 = total - (whole << 16);
+        whole
+    }
+
+    /// Forget the history (after a fault: slopes across the gap are not valid).
+    pub fn reset(&mut self) {
+        self.prev_slope = 0;
+    }
+}

@@ -1,0 +1,108 @@
+//! Test rig: the firmware's FOG core closed around the simulated optics, sample
+//! by sample, on an input-rate profile. Used by the host tests, `gyro-lab` and
+//! (in f32) by the `qemu` firmware.
+
+use super::{FogOptics, OpticsParams, Profile};
+use crate::fog::{ClosureOutput, FogConfig, FogLoop, MAX_HALF, MAX_SAMPLES_PER_HALF};
+use num_traits::Float;
+use rand_distr::{Distribution, StandardNormal};
+
+pub struct FogRig<F> {
+    pub cfg: FogConfig,
+    pub fog: FogLoop,
+    pub optics: FogOptics<F>,
+    pub profile: Profile<F>,
+    k_sagnac: F,
+    step_index: u64,
+    dac: [u16; MAX_HALF],
+    adc: [u16; MAX_HALF * MAX_SAMPLES_PER_HALF],
+    sagnac: [F; MAX_HALF],
+}
+
+/// One step of the rig: the core's output and the truth.
+#[derive(Clone, Copy, Debug)]
+pub struct RigStep<F> {
+    pub out: ClosureOutput,
+    /// Mean true rate over the step (of the per-half-period rates), rad/s.
+    pub true_rate: F,
+    /// Time at the end of the step, s.
+    pub t_end: F,
+}
+
+impl<F: Float> FogRig<F>
+where
+    StandardNormal: Distribution<F>,
+{
+    pub fn new(cfg: FogConfig, optics: OpticsParams<F>, profile: Profile<F>) -> Self {
+        let mut fog = FogLoop::new(&cfg);
+        let mut dac = [0u16; MAX_HALF];
+        fog.start(&cfg, &mut dac);
+        Self {
+            k_sagnac: F::from(cfg.k_sagnac_s).unwrap_or(F::one()),
+            cfg,
+            fog,
+            optics: FogOptics::new(optics),
+            profile,
+            step_index: 0,
+            dac,
+            adc: [0; MAX_HALF * MAX_SAMPLES_PER_HALF],
+            sagnac: [F::zero(); MAX_HALF],
+        }
+    }
+
+    pub fn step_index(&self) -> u64 {
+        self.step_index
+    }
+
+    /// Runs one closure step.
+    pub fn step(&mut self) -> RigStep<F> {
+        let true_rate = self.simulate_optics();
+        let out = self.process_core();
+        self.finish(out, true_rate)
+    }
+
+    /// First half of a step: the optics produce the ADC samples of the DAC words
+    /// now applied. Returns the mean true rate over the step, rad/s.
+    pub fn simulate_optics(&mut self) -> F {
+        let n = self.cfg.n_half;
+        let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
+        let half = F::from(0.5).unwrap_or(F::zero());
+        let first = self.step_index * n as u64;
+        let mut sum = F::zero();
+        for (j, s) in self.sagnac.iter_mut().take(n).enumerate() {
+            let t = (F::from(first + j as u64).unwrap_or(F::zero()) + half) * tau;
+            let rate = self.profile.rate_at(t);
+            sum = sum + rate;
+            *s = self.k_sagnac * rate;
+        }
+        let ns = self.cfg.n_samples;
+        let (dac, adc, sagnac) = (&self.dac[..n], &mut self.adc[..ns], &self.sagnac[..n]);
+        self.optics.run_step(dac, sagnac, adc);
+        sum / F::from(n).unwrap_or(F::one())
+    }
+
+    /// Second half: the firmware's closure step on those samples (this is what
+    /// the interrupt runs on the MCU).
+    #[inline(never)]
+    pub fn process_core(&mut self) -> ClosureOutput {
+        let (n, ns) = (self.cfg.n_half, self.cfg.n_samples);
+        self.fog
+            .process(&self.cfg, &self.adc[..ns], &mut self.dac[..n])
+    }
+
+    fn finish(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
+        self.step_index += 1;
+        let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
+        let t_end = F::from(self.step_index * self.cfg.n_half as u64).unwrap_or(F::zero()) * tau;
+        RigStep {
+            out,
+            true_rate,
+            t_end,
+        }
+    }
+
+    /// Completes a step run as `simulate_optics` + `process_core`.
+    pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
+        self.finish(out, true_rate)
+    }
+}

@@ -1,0 +1,12 @@
+//! The simulated gyro: the same model on the host (f64) and inside the `qemu`
+//! firmware (f32). Generic over the float type through `num_traits::Float`
+//! (libm underneath, accurate to the last bit or two; no micromath here because
+//! the second-order fringe terms need full precision).
+
+pub mod fog_optics;
+pub mod fog_rig;
+pub mod profile;
+
+pub use fog_optics::{FogOptics, OpticsParams};
+pub use fog_rig::FogRig;
+pub use profile::{Profile, Segment};

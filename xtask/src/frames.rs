@@ -1,0 +1,278 @@
+//! Decoding of the firmware's UART frames into a run file, and the summary.
+
+use anyhow::{Context, Result};
+use gyro_sp::fog::{Faults, FogConfig, FogParams};
+use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
+use gyro_sp::sim::profile::qemu_demo;
+use std::io::Write;
+use std::path::Path;
+
+const DEG: f64 = std::f64::consts::PI / 180.0;
+const DPH: f64 = 3600.0 / DEG;
+
+pub struct Row {
+    pub t_s: f64,
+    pub ref_rate: f64,
+    pub rate: f64,
+    pub rate_raw: f64,
+    pub frame: Frame,
+    pub segment: usize,
+    pub t_in_segment: f64,
+}
+
+pub struct Report {
+    pub rows: Vec<Row>,
+    pub bad_frames: usize,
+    pub seq_gaps: usize,
+    pub step_gaps: usize,
+    pub segment_names: [&'static str; 8],
+    pub cfg: FogConfig,
+}
+
+/// Decodes frames (resynchronising on the sync word) and rebuilds the truth
+/// from the firmware's built-in profile.
+pub fn analyse(path: &Path) -> Result<Report> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let cfg = FogConfig::new(FogParams::default()).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let (profile, names) = qemu_demo::<f64>();
+    let seg_starts: Vec<f64> = profile
+        .segments
+        .iter()
+        .scan(0.0, |t, s| {
+            let start = *t;
+            *t += s.duration();
+            Some(start)
+        })
+        .collect();
+    let n_half = cfg.n_half as u64;
+    let tau = cfg.params.tau_s;
+    let (mut i, mut bad) = (0usize, 0usize);
+    let mut rows = Vec::new();
+    let (mut seq_gaps, mut step_gaps) = (0, 0);
+    let mut last: Option<Frame> = None;
+    while i + FRAME_LEN <= bytes.len() {
+        if bytes[i..i + 2] != SYNC {
+            i += 1;
+            continue;
+        }
+        match Frame::decode(&bytes[i..]) {
+            Ok(f) => {
+                if let Some(p) = last {
+                    if f.seq != p.seq.wrapping_add(1) {
+                        seq_gaps += 1;
+                    }
+                    if f.step_counter.wrapping_sub(p.step_counter) != f.steps as u32 {
+                        step_gaps += 1;
+                    }
+                }
+                last = Some(f);
+                let end = f.step_counter as u64;
+                let start = end - f.steps as u64;
+                let mut truth = 0.0;
+                for k in start..end {
+                    for j in 0..n_half {
+                        truth += profile.rate_at(((k * n_half + j) as f64 + 0.5) * tau);
+                    }
+                }
+                let halves = (f.steps as u64 * n_half) as f64;
+                let lsb = cfg.rad_s_per_step_lsb();
+                let t_mid = (start + end) as f64 / 2.0 * n_half as f64 * tau;
+                let segment = seg_starts.iter().rposition(|&s| t_mid >= s).unwrap_or(0);
+                rows.push(Row {
+                    t_s: end as f64 * n_half as f64 * tau,
+                    ref_rate: truth / halves,
+                    rate: f.fog_angle as f64 * lsb / halves,
+                    rate_raw: f.fog_angle_raw as f64 * lsb / halves,
+                    frame: f,
+                    segment,
+                    t_in_segment: t_mid - seg_starts[segment],
+                });
+                i += FRAME_LEN;
+            }
+            Err(_) => {
+                bad += 1;
+                i += 1;
+            }
+        }
+    }
+    Ok(Report {
+        rows,
+        bad_frames: bad,
+        seq_gaps,
+        step_gaps,
+        segment_names: names,
+        cfg,
+    })
+}
+
+pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(
+        w,
+        "# gyro-fw under qemu-system-arm (netduinoplus2), built-in profile; one row per frame"
+    )?;
+    writeln!(
+        w,
+        "t_s,ref_rate_dps,rate_dps,rate_raw_dps,faults,seq,dc_lsb,codes_per_turn"
+    )?;
+    for row in &r.rows {
+        writeln!(
+            w,
+            "{:.6},{:.9},{:.9},{:.9},{},{},{},{:.4}",
+            row.t_s,
+            row.ref_rate / DEG,
+            row.rate / DEG,
+            row.rate_raw / DEG,
+            row.frame.faults,
+            row.frame.seq,
+            row.frame.dc,
+            row.frame.codes_per_turn_q8 as f64 / 256.0
+        )?;
+    }
+    Ok(())
+}
+
+/// Per segment: mean and RMS of output minus truth (deg/h) after 20 ms settling.
+pub struct SegmentStats {
+    pub name: &'static str,
+    pub frames: usize,
+    pub mean_dph: f64,
+    pub rms_dph: f64,
+    pub mean_raw_dph: f64,
+    pub faults: u16,
+}
+
+pub fn segment_stats(r: &Report) -> Vec<SegmentStats> {
+    (0..r.segment_names.len())
+        .map(|s| {
+            let rows: Vec<&Row> = r
+                .rows
+                .iter()
+                .filter(|x| x.segment == s && x.t_in_segment > 0.02)
+                .collect();
+            let n = rows.len().max(1) as f64;
+            let mean = rows.iter().map(|x| x.rate - x.ref_rate).sum::<f64>() / n;
+            let raw = rows.iter().map(|x| x.rate_raw - x.ref_rate).sum::<f64>() / n;
+            let rms = (rows
+                .iter()
+                .map(|x| (x.rate - x.ref_rate).powi(2))
+                .sum::<f64>()
+                / n)
+                .sqrt();
+            SegmentStats {
+                name: r.segment_names[s],
+                frames: rows.len(),
+                mean_dph: mean * DPH,
+                rms_dph: rms * DPH,
+                mean_raw_dph: raw * DPH,
+                faults: r
+                    .rows
+                    .iter()
+                    .filter(|x| x.segment == s)
+                    .fold(0, |a, x| a | x.frame.faults),
+            }
+        })
+        .collect()
+}
+
+pub fn print_summary(r: &Report) {
+    println!(
+        "frames: {} decoded, {} bad, {} sequence gaps, {} step gaps",
+        r.rows.len(),
+        r.bad_frames,
+        r.seq_gaps,
+        r.step_gaps
+    );
+    println!(
+        "{:<28} {:>6} {:>14} {:>14} {:>16}  faults",
+        "segment", "frames", "mean err deg/h", "rms err deg/h", "uncorrected deg/h"
+    );
+    for s in segment_stats(r) {
+        println!(
+            "{:<28} {:>6} {:>14.4} {:>14.3} {:>16.4}  {:#06x}",
+            s.name, s.frames, s.mean_dph, s.rms_dph, s.mean_raw_dph, s.faults
+        );
+    }
+    let eps = 50_000.0 * DEG;
+    let pred = r.cfg.predicted_vibration_drift(eps * eps / 2.0) * DPH;
+    println!("vibration drift formula (-(1/4) cot(phi0) K_s <eps^2> dt_m dt_p): {pred:.4} deg/h");
+}
+
+/// The firmware tests under QEMU: (name, passed, detail).
+pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
+    let stats = segment_stats(r);
+    let expected_frames = 30_000 / 25;
+    let mut v = vec![
+        (
+            "frames_decode",
+            r.bad_frames == 0 && r.rows.len() == expected_frames,
+            format!(
+                "{} of {expected_frames}, {} bad",
+                r.rows.len(),
+                r.bad_frames
+            ),
+        ),
+        (
+            "no_sequence_gaps",
+            r.seq_gaps == 0 && r.step_gaps == 0,
+            format!("{} seq gaps, {} step gaps", r.seq_gaps, r.step_gaps),
+        ),
+        ("no_panic", !log.contains("panic"), "firmware log".into()),
+    ];
+    // Locked: every constant-rate segment tracked (mean error under 1 deg/h, no lock fault).
+    for s in stats
+        .iter()
+        .filter(|s| !s.name.starts_with("vibration") && !s.name.starts_with("ramp"))
+    {
+        let ok = s.mean_dph.abs() < 1.0 && s.faults & Faults::OUT_OF_LOCK == 0;
+        v.push(("locked", ok, format!("{}: {:.4} deg/h", s.name, s.mean_dph)));
+    }
+    let vib = stats.iter().find(|s| s.name.starts_with("vibration"));
+    if let Some(s) = vib {
+        let ok = s.mean_dph.abs() < 0.1 * s.mean_raw_dph.abs();
+        v.push((
+            "vibration_correction",
+            ok,
+            format!(
+                "{:.3} deg/h corrected vs {:.3} raw",
+                s.mean_dph, s.mean_raw_dph
+            ),
+        ));
+    }
+    let fault_rows: Vec<&Row> = r
+        .rows
+        .iter()
+        .filter(|x| x.frame.faults & Faults::OPTICAL_POWER_LOW != 0)
+        .collect();
+    let cleared = r
+        .rows
+        .last()
+        .is_some_and(|x| x.frame.faults & Faults::OPTICAL_POWER_LOW == 0);
+    v.push((
+        "power_loss_flag_rises_and_clears",
+        !fault_rows.is_empty() && cleared,
+        format!("{} flagged frames", fault_rows.len()),
+    ));
+    v
+}
+
+/// Flash (vector table, code, read-only data, initialised data) and static RAM.
+pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
+    use object::{Object, ObjectSection};
+    let data = std::fs::read(elf)?;
+    let file = object::File::parse(&*data)?;
+    let (mut flash, mut ram) = (0, 0);
+    for s in file.sections() {
+        let name = s.name().unwrap_or("");
+        match name {
+            ".vector_table" | ".text" | ".rodata" => flash += s.size(),
+            ".data" => {
+                flash += s.size();
+                ram += s.size();
+            }
+            ".bss" | ".uninit" => ram += s.size(),
+            _ => {}
+        }
+    }
+    Ok((flash, ram))
+}

@@ -1,0 +1,226 @@
+//! `cargo xtask qemu | test | bench`: developer entry points. Each first installs
+//! what it needs (thumbv7em target, qemu-system-arm, flip-link, defmt-print).
+
+mod frames;
+mod setup;
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let r = match args.first().map(String::as_str) {
+        Some("qemu") => qemu_cmd(),
+        Some("test") => test_cmd(),
+        Some("bench") => bench_cmd(),
+        _ => {
+            eprintln!("usage: cargo xtask <qemu|test|bench>");
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = r {
+        eprintln!("xtask: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
+}
+
+pub fn run(cmd: &mut Command) -> Result<()> {
+    eprintln!("$ {:?}", cmd);
+    let st = cmd
+        .current_dir(root())
+        .status()
+        .with_context(|| format!("running {cmd:?}"))?;
+    if !st.success() {
+        bail!("{cmd:?} failed: {st}");
+    }
+    Ok(())
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// Builds the firmware for a board feature and returns the ELF path.
+pub fn build_firmware(feature: &str) -> Result<PathBuf> {
+    run(cargo().args([
+        "build",
+        "--release",
+        "--target",
+        TARGET,
+        "--bin",
+        "gyro-fw",
+        "--features",
+        feature,
+    ]))?;
+    Ok(root()
+        .join("target")
+        .join(TARGET)
+        .join("release")
+        .join("gyro-fw"))
+}
+
+/// Output of one QEMU run.
+pub struct QemuRun {
+    pub log: String,
+    pub frames_path: PathBuf,
+    pub elf: PathBuf,
+}
+
+/// Runs the `qemu` firmware deterministically (-icount shift=0) and decodes defmt.
+pub fn run_qemu() -> Result<QemuRun> {
+    let elf = build_firmware("qemu")?;
+    let dir = root().join("runs");
+    std::fs::create_dir_all(&dir)?;
+    let frames_path = dir.join("qemu-frames.bin");
+    let raw_log = dir.join("qemu-defmt.bin");
+    let out = std::fs::File::create(&raw_log)?;
+    eprintln!(
+        "$ qemu-system-arm -machine netduinoplus2 ... -kernel {}",
+        elf.display()
+    );
+    let st = Command::new("qemu-system-arm")
+        .args([
+            "-machine",
+            "netduinoplus2",
+            "-cpu",
+            "cortex-m4",
+            "-nographic",
+            "-monitor",
+            "none",
+        ])
+        .args([
+            "-semihosting-config",
+            "enable=on,target=native",
+            "-icount",
+            "shift=0",
+        ])
+        .arg("-serial")
+        .arg(format!("file:{}", frames_path.display()))
+        .arg("-kernel")
+        .arg(&elf)
+        .stdin(Stdio::null())
+        .stdout(out)
+        .status()
+        .context("starting qemu-system-arm")?;
+    let decoded = Command::new("defmt-print")
+        .arg("-e")
+        .arg(&elf)
+        .stdin(std::fs::File::open(&raw_log)?)
+        .output()
+        .context("running defmt-print")?;
+    let log = String::from_utf8_lossy(&decoded.stdout).into_owned();
+    print!("{log}");
+    if !st.success() {
+        bail!("firmware under QEMU exited with {st}");
+    }
+    Ok(QemuRun {
+        log,
+        frames_path,
+        elf,
+    })
+}
+
+fn qemu_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    let run = run_qemu()?;
+    let report = frames::analyse(&run.frames_path)?;
+    let csv = root().join("runs").join("qemu-fog.csv");
+    frames::write_run_file(&report, &csv)?;
+    frames::print_summary(&report);
+    println!("run file: {}", csv.display());
+    Ok(())
+}
+
+fn test_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    run(cargo().args(["fmt", "--all", "--check"]))?;
+    run(cargo().args([
+        "clippy",
+        "--workspace",
+        "--release",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ]))?;
+    for f in ["qemu", "hw"] {
+        run(cargo().args([
+            "clippy",
+            "--release",
+            "--target",
+            TARGET,
+            "--bin",
+            "gyro-fw",
+            "--features",
+            f,
+            "--",
+            "-D",
+            "warnings",
+        ]))?;
+    }
+    run(cargo().args(["test", "--workspace", "--release"]))?;
+    build_firmware("hw")?;
+    // Tests of the firmware under QEMU.
+    let run = run_qemu()?;
+    let report = frames::analyse(&run.frames_path)?;
+    frames::print_summary(&report);
+    let checks = frames::qemu_checks(&report, &run.log);
+    let failed = checks.iter().filter(|c| !c.1).count();
+    for (name, ok, detail) in &checks {
+        println!(
+            "qemu test {name} ... {} ({detail})",
+            if *ok { "ok" } else { "FAILED" }
+        );
+    }
+    println!("qemu: {} passed, {} failed", checks.len() - failed, failed);
+    if failed > 0 {
+        bail!("{failed} firmware test(s) under QEMU failed");
+    }
+    Ok(())
+}
+
+fn bench_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    let qrun = run_qemu()?;
+    let grab = |key: &str| -> Option<u64> {
+        let line = qrun.log.lines().find(|l| l.contains("bench:"))?;
+        let v = line
+            .split_whitespace()
+            .find_map(|w| w.strip_prefix(&format!("{key}=")))?;
+        v.trim().parse().ok()
+    };
+    let instr = grab("fog_closure_instructions").context("no bench line in the firmware log")?;
+    let stack = grab("stack_bytes").context("no stack figure in the firmware log")?;
+    let (flash, ram) = frames::elf_sizes(&qrun.elf)?;
+    // Real-time factor of the host simulator (release build, default options).
+    run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
+    let lab = root().join("target/release/gyro-lab");
+    let out = Command::new(&lab)
+        .args(["simulate", "fog", "--duration-s", "20", "--json"])
+        .output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or("{}"))?;
+    let rtf = v["realtime_factor"]
+        .as_f64()
+        .context("no realtime_factor from gyro-lab")?;
+    let j = serde_json::json!({
+        "fog_closure_instructions": instr,
+        "fog_closure_instructions_max": grab("max"),
+        "sim_fog_realtime_factor": (rtf * 10.0).round() / 10.0,
+        "flash_bytes": flash,
+        "ram_bytes": ram,
+        "stack_bytes": stack,
+    });
+    println!("{j}");
+    Ok(())
+}
