@@ -5,6 +5,7 @@
 use super::{MAX_HALF, MAX_SAMPLES_PER_HALF};
 use crate::{phase_from_rad, Phase};
 use core::f64::consts::{PI, TAU};
+#[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
 
 /// Speed of light in vacuum, m/s.
@@ -146,7 +147,7 @@ impl FogConfig {
         let n_half = halves.round() as usize;
         if (halves - n_half as f64).abs() > 1e-6
             || n_half < 2
-            || n_half % 2 != 0
+            || !n_half.is_multiple_of(2)
             || n_half > MAX_HALF
         {
             return Err(ConfigError::HalfPeriods);
@@ -160,8 +161,10 @@ impl FogConfig {
         if !(p.phi0_rad > 0.0 && p.phi0_rad < PI) {
             return Err(ConfigError::Phi0);
         }
-        if !(p.loop_gain > 0.0 && p.loop_gain < 2.0)
-            || !(p.gain_loop_gain >= 0.0 && p.gain_loop_gain < 1.0)
+        if !(p.loop_gain > 0.0
+            && p.loop_gain < 2.0
+            && p.gain_loop_gain >= 0.0
+            && p.gain_loop_gain < 1.0)
         {
             return Err(ConfigError::LoopGain);
         }

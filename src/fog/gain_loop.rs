@@ -20,7 +20,7 @@ pub fn reset_error(halves: &[u32], resets: Resets, dc: u32) -> i32 {
         bits &= bits - 1;
         if let Some(&h) = halves.get(j as usize) {
             let dev = h as i32 - mean;
-            let w_sign_positive = ((resets.up >> j) & 1 == 1) == (j % 2 == 0);
+            let w_sign_positive = ((resets.up >> j) & 1 == 1) == j.is_multiple_of(2);
             acc += if w_sign_positive { dev } else { -dev };
         }
     }

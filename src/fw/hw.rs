@@ -12,6 +12,7 @@
 //!   rigs apply it on the next step); physics.md's coefficient must be re-derived
 //!   for that loop before trusting the epsilon-squared correction on the board.
 //! - Frames on USART1 (PA9) at 2 Mbaud; independent watchdog at 100 ms.
+//!
 //! Registers are written as whole words with the bit meaning in the comment.
 
 use super::{stack, uart, FrameQueue, STEPS_PER_FRAME};
@@ -130,9 +131,10 @@ pub fn run() -> ! {
     let mut frames = FrameBuilder::new(STEPS_PER_FRAME, cfg.n_half);
     if watchdog_reset {
         // Tell the host through the first frame that the board restarted.
-        let mut f = Frame::default();
-        f.faults = Faults::RESET_RECOVERED;
-        frames.restore(f);
+        frames.restore(Frame {
+            faults: Faults::RESET_RECOVERED,
+            ..Frame::default()
+        });
     }
     let iwdg = &dp.IWDG;
     iwdg.kr().write(|w| unsafe { w.bits(0x5555) });

@@ -1,0 +1,82 @@
+//! Output frames: round trip, CRC, no loss of angle when the queue is full.
+
+use gyro_sp::fog::{ClosureOutput, Faults};
+use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
+use proptest::prelude::*;
+
+fn out(step: i64) -> ClosureOutput {
+    ClosureOutput {
+        step,
+        step_corrected: step - 3,
+        ..ClosureOutput::default()
+    }
+}
+
+#[test]
+fn round_trip_and_crc() {
+    let f = Frame {
+        seq: 7,
+        faults: 5,
+        steps: 25,
+        step_counter: 1234,
+        fog_angle: -99,
+        fog_angle_raw: 1 << 40,
+        fog_residual: -5,
+        codes_per_turn_q8: 12_582_912,
+        dc: 25_000,
+    };
+    let b = f.encode();
+    assert_eq!(Frame::decode(&b), Ok(f));
+    let mut bad = b;
+    bad[20] ^= 1;
+    assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
+    assert_eq!(Frame::decode(&b[..FRAME_LEN - 1]), Err(FrameError::Length));
+}
+
+#[test]
+fn restored_frame_loses_no_angle() {
+    let mut fb = FrameBuilder::new(4, 16);
+    let mut emitted = Vec::new();
+    let mut total = 0i64;
+    for k in 0..40 {
+        total += (k - 3) * 16;
+        if let Some(f) = fb.push(&out(k), k as u32 + 1) {
+            // Every other frame "does not fit in the queue".
+            if f.seq % 2 == 1 && emitted.len() < 6 {
+                fb.restore(f);
+            } else {
+                emitted.push(f);
+            }
+        }
+    }
+    let sent: i64 = emitted.iter().map(|f| f.fog_angle).sum();
+    let pending = 40 - emitted.iter().map(|f| f.steps as i64).sum::<i64>();
+    let pending_angle: i64 = (40 - pending..40).map(|k| (k - 3) * 16).sum();
+    assert_eq!(sent + pending_angle, total);
+    assert!(emitted.iter().any(|f| f.faults & Faults::QUEUE_FULL != 0));
+    for w in emitted.windows(2) {
+        assert_eq!(
+            w[1].seq,
+            w[0].seq.wrapping_add(1),
+            "sequence numbers stay contiguous"
+        );
+    }
+}
+
+proptest! {
+    #[test]
+    fn decode_never_panics(bytes in proptest::collection::vec(any::<u8>(), 0..100)) {
+        let _ = Frame::decode(&bytes);
+    }
+
+    /// The closure step takes any ADC input without panicking.
+    #[test]
+    fn closure_never_panics(adc in proptest::collection::vec(any::<u16>(), 0..80)) {
+        let cfg = gyro_sp::fog::FogConfig::new(gyro_sp::fog::FogParams::default()).unwrap();
+        let mut fog = gyro_sp::fog::FogLoop::new(&cfg);
+        let mut dac = [0u16; 16];
+        for _ in 0..3 {
+            let _ = fog.process(&cfg, &adc, &mut dac);
+        }
+    }
+}
