@@ -58,7 +58,7 @@ where
     pub fn step(&mut self) -> RigStep<F> {
         let true_rate = self.simulate_optics();
         let out = self.process_core();
-        self.finish(out, true_rate)
+        self.finish_step(out, true_rate)
     }
 
     /// First half of a step: the optics produce the ADC samples of the DAC words
@@ -90,7 +90,8 @@ where
             .process(&self.cfg, &self.adc[..ns], &mut self.dac[..n])
     }
 
-    fn finish(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
+    /// Completes a step run as `simulate_optics` + `process_core`.
+    pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
         self.step_index += 1;
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
         let t_end = F::from(self.step_index * self.cfg.n_half as u64).unwrap_or(F::zero()) * tau;
@@ -99,10 +100,5 @@ where
             true_rate,
             t_end,
         }
-    }
-
-    /// Completes a step run as `simulate_optics` + `process_core`.
-    pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
-        self.finish(out, true_rate)
     }
 }
