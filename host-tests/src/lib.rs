@@ -19,10 +19,7 @@ pub fn rig(
         params.dac_codes_per_turn,
     );
     tweak(&mut optics);
-    let params = FogParams {
-        nominal_dc_lsb: optics.operating_dc(params.phi0_rad),
-        ..params
-    };
+    let params = optics.matched(params);
     let cfg = FogConfig::new(params).expect("valid parameters");
     FogRig::new(cfg, optics, profile)
 }

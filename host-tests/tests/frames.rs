@@ -70,14 +70,23 @@ proptest! {
         let _ = Frame::decode(&bytes);
     }
 
-    /// The closure step takes any ADC input without panicking.
+    /// The closure step takes any ADC input and watchdog flag without panicking,
+    /// and its DAC words stay inside the digital gain's range.
     #[test]
-    fn closure_never_panics(adc in proptest::collection::vec(any::<u16>(), 0..80)) {
+    fn closure_never_panics(
+        adc in proptest::collection::vec(any::<u16>(), 0..80),
+        over_range in any::<bool>(),
+    ) {
         let cfg = gyro_sp::fog::FogConfig::new(gyro_sp::fog::FogParams::default()).unwrap();
         let mut fog = gyro_sp::fog::FogLoop::new(&cfg);
         let mut dac = [0u16; 16];
         for _ in 0..3 {
-            let _ = fog.process(&cfg, &adc, &mut dac);
+            let out = fog.process(&cfg, &adc, over_range, &mut dac);
+            prop_assert!(out.codes_per_turn_q8 >= cfg.cpt_min_q8 && out.codes_per_turn_q8 <= cfg.cpt_max_q8);
+            prop_assert!(dac.iter().all(|&d| u32::from(d) <= cfg.cpt_max_q8 >> 8));
+            if adc.len() < cfg.n_samples || over_range {
+                prop_assert!(out.faults.has(gyro_sp::fog::Faults::ADC_SATURATION));
+            }
         }
     }
 }

@@ -59,7 +59,7 @@ pub struct FogArgs {
     #[arg(long, default_value_t = 12)]
     pub adc_bits: u32,
     /// Modulation-depth dither width, bits of phase (0 = off).
-    #[arg(long, default_value_t = 25)]
+    #[arg(long, default_value_t = 27)]
     pub dither_bits: u32,
     /// Start-up time left out of the mean error, s.
     #[arg(long, default_value_t = 0.02)]
@@ -146,10 +146,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
     optics.seed = a.seed;
     optics.adc_bits = a.adc_bits;
     optics.vpi_gain_error = a.vpi_error;
-    let params = FogParams {
-        nominal_dc_lsb: optics.operating_dc(a.phi0_rad),
-        ..params
-    };
+    let params = optics.matched(params);
     let cfg = FogConfig::new(params)
         .map_err(|e| LabError::Usage(format!("invalid loop parameters: {e:?}")))?;
 

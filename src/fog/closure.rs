@@ -9,9 +9,8 @@ use super::config::FogConfig;
 use super::demod::demodulate;
 use super::faults::Faults;
 use super::gain_loop;
-use super::modulator::{Modulator, Resets};
+use super::modulator::{Carries, Modulator};
 use super::vibration::VibrationCorrection;
-use super::MAX_HALF;
 
 /// What one closure step produces.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -46,10 +45,9 @@ pub struct FogLoop {
     /// The DC filter holds a measured value (seeded on the first good step).
     dc_valid: bool,
     modulator: Modulator,
-    /// Resets of the DAC words now being applied (measured in the next call).
-    pending_resets: Resets,
+    /// Where the DAC words now being applied reset (used in the next call).
+    carries: Carries,
     vibration: VibrationCorrection,
-    halves: [u32; MAX_HALF],
     unlocked_steps: u16,
     faults: Faults,
     /// xorshift32 state of the depth dither.
@@ -67,9 +65,8 @@ impl FogLoop {
             dc_q12: (cfg.h0_nominal as u64) << 12,
             dc_valid: false,
             modulator: Modulator::default(),
-            pending_resets: Resets::default(),
+            carries: Carries::default(),
             vibration: VibrationCorrection::default(),
-            halves: [0; MAX_HALF],
             unlocked_steps: 0,
             faults: Faults::default(),
             dither: 0x9E37_79B9,
@@ -78,12 +75,11 @@ impl FogLoop {
 
     /// Writes the first step's DAC words (before any ADC data exists).
     pub fn start(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
-        let n = cfg.n_half.min(dac.len());
-        if let Some(dac) = dac.get_mut(..n) {
-            let depth = self.next_depth(cfg);
-            self.pending_resets =
-                self.modulator
-                    .write_step(self.step as u32, depth, self.cpt_q8, dac);
+        let depth = self.next_depth(cfg);
+        if let Some(dac) = dac.get_mut(..cfg.n_half) {
+            self.carries = self
+                .modulator
+                .write_step(self.step as u32, depth, self.cpt_q8, dac);
         }
     }
 
@@ -100,41 +96,53 @@ impl FogLoop {
     }
 
     /// One closure step. `adc`: `cfg.n_samples` samples of the step just applied;
+    /// `adc_over_range`: the ADC's analog watchdog fired during them;
     /// `dac`: receives `cfg.n_half` words for the next step. Never panics: short
-    /// buffers are treated as a saturated (discarded) step.
-    pub fn process(&mut self, cfg: &FogConfig, adc: &[u16], dac: &mut [u16]) -> ClosureOutput {
+    /// buffers are treated as a lost (held) step.
+    pub fn process(
+        &mut self,
+        cfg: &FogConfig,
+        adc: &[u16],
+        adc_over_range: bool,
+        dac: &mut [u16],
+    ) -> ClosureOutput {
         let n_half = cfg.n_half;
-        let (Some(adc), Some(dac), Some(halves)) = (
-            adc.get(..cfg.n_samples),
-            dac.get_mut(..n_half),
-            self.halves.get_mut(..n_half),
-        ) else {
+        let (Some(adc), Some(dac)) = (adc.get(..cfg.n_samples), dac.get_mut(..n_half)) else {
             self.faults.set(Faults::ADC_SATURATION, true);
             return self.output(self.step, 0, 0, 0);
         };
-        let sums = demodulate(adc, cfg.samples_per_half, cfg.skip_samples, halves);
-        let h_step = sums.dc / n_half as u32;
+        let sums = demodulate(
+            adc,
+            cfg.samples_per_half,
+            cfg.skip_samples,
+            n_half,
+            &self.carries,
+        );
+        // Detector DC of one half period, ADC dark level removed (per-half sum).
+        let h_step = (sums.dc / n_half as u32).saturating_sub(cfg.dark_half);
         let power_low = h_step < cfg.h0_min;
         self.faults.set(Faults::OPTICAL_POWER_LOW, power_low);
-        self.faults.set(Faults::ADC_SATURATION, sums.saturated);
+        self.faults.set(Faults::ADC_SATURATION, adc_over_range);
 
         let mut residual = 0i64;
         let mut bias = 0i64;
         // Sagnac phase measured over this step: applied step plus residual.
         let mut measured = self.step;
-        if power_low || sums.saturated {
-            // Safe path: hold the step and the gain; the output keeps integrating
-            // the last good rate (flagged); AGC and correction restart afterwards.
+        if power_low {
+            // Safe path: the error means nothing without light. Hold the step and
+            // the gain; the output repeats the last good step (flagged); AGC and
+            // the correction restart when the light comes back.
             self.vibration.reset();
             self.dc_valid = false;
         } else {
             // Slow AGC: normalise by a low-passed DC so the loop gain does not depend
             // on optical power, without correlating the gain with this step's error.
-            if self.dc_valid {
-                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step as u64;
-            } else {
+            // Frozen while the ADC clips (the DC is then wrong).
+            if !self.dc_valid {
                 self.dc_q12 = (h_step as u64) << 12;
-                self.dc_valid = true;
+                self.dc_valid = !adc_over_range;
+            } else if !adc_over_range {
+                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step as u64;
             }
             let h = ((self.dc_q12 >> 12) as u32).max(1);
             let recip_h = u32::MAX / h; // 2^32 / H
@@ -145,22 +153,27 @@ impl FogLoop {
             let slope = ((2 * (sums.first as i64 - sums.second as i64) * kn) >> 24)
                 .clamp(i32::MIN as i64, i32::MAX as i64) as i32;
 
+            // Clipped samples still give the error's sign, so the main loop keeps
+            // running through over-range (holding it could lock it there); the
+            // gain loop and the correction, which need true levels, pause.
             measured = self.step + residual;
             self.step =
                 (self.step + ((residual * cfg.loop_gain_q16) >> 16)).clamp(-STEP_LIMIT, STEP_LIMIT);
-
-            let err = gain_loop::reset_error(halves, self.pending_resets, sums.dc);
-            self.cpt_q8 = gain_loop::update(
-                self.cpt_q8,
-                err,
-                cfg.gain_loop_q16,
-                recip_h,
-                cfg.cpt_min_q8,
-                cfg.cpt_max_q8,
-            );
-
-            if cfg.vibration_correction {
-                bias = self.vibration.update(slope, cfg.vib_coeff, cfg.vib_shift);
+            if adc_over_range {
+                self.vibration.reset();
+            } else {
+                let err = gain_loop::reset_error(&sums, &self.carries, n_half as u32);
+                self.cpt_q8 = gain_loop::update(
+                    self.cpt_q8,
+                    err,
+                    cfg.gain_loop_q16,
+                    recip_h,
+                    cfg.cpt_min_q8,
+                    cfg.cpt_max_q8,
+                );
+                if cfg.vibration_correction {
+                    bias = self.vibration.update(slope, cfg.vib_coeff, cfg.vib_shift);
+                }
             }
             let unlocked = residual.unsigned_abs() > cfg.lock_limit as u64;
             self.unlocked_steps = if unlocked {
@@ -176,7 +189,7 @@ impl FogLoop {
         }
         let out = self.output(measured, residual, bias, h_step);
         let depth = self.next_depth(cfg);
-        self.pending_resets = self
+        self.carries = self
             .modulator
             .write_step(self.step as u32, depth, self.cpt_q8, dac);
         out

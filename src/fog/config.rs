@@ -36,14 +36,19 @@ pub struct FogParams {
     pub gain_loop_gain: f64,
     /// DAC codes that give 2*pi at the modulator at nominal V_pi.
     pub dac_codes_per_turn: u32,
-    /// Depth dither: uniform over 2^dither_bits phase LSB (0 = off); 25 bits is
-    /// +-0.025 rad, several ADC LSB of detector level.
+    /// Depth dither: uniform over 2^dither_bits phase LSB (0 = off); 27 bits is
+    /// +-0.1 rad, about +-120 codes of a 12-bit ADC at the operating point: enough
+    /// to average its rounding below 0.2 ppm of scale factor (25 bits left 1 ppm).
     pub dither_bits: u32,
     /// Online epsilon-squared correction on.
     pub vibration_correction: bool,
-    /// Expected DC level of one kept ADC sample at the operating point, LSB
-    /// (sets the optical-power-low threshold and the start-up normalisation).
+    /// Expected DC level of one kept ADC sample at the operating point, above
+    /// the dark level, LSB (sets the optical-power-low threshold and the
+    /// start-up normalisation).
     pub nominal_dc_lsb: f64,
+    /// ADC reading with no light (detector dark output plus ADC offset), LSB per
+    /// sample; the front end sits above zero so a dark fringe is not clipped.
+    pub dark_lsb: f64,
 }
 
 impl Default for FogParams {
@@ -62,9 +67,10 @@ impl Default for FogParams {
             loop_gain: 1.0,
             gain_loop_gain: 0.05,
             dac_codes_per_turn: 49_152,
-            dither_bits: 25,
+            dither_bits: 27,
             vibration_correction: true,
             nominal_dc_lsb: 8_000.0,
+            dark_lsb: 1_024.0,
         }
     }
 }
@@ -72,11 +78,12 @@ impl Default for FogParams {
 /// Why a parameter set was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ConfigError {
-    /// Closure period is not a whole, even number of half periods, or too many.
+    /// Closure period is not a whole multiple of 4 half periods (each half of a
+    /// step holds whole +-phi0 pairs), or too many.
     HalfPeriods,
     /// Samples per half period or skipped samples out of range.
     Samples,
-    /// phi0 outside (0, pi).
+    /// phi0 outside [0.1, pi - 0.1] rad.
     Phi0,
     /// Loop gain outside (0, 2) (the one-step integrator is unstable beyond).
     LoopGain,
@@ -123,7 +130,9 @@ pub struct FogConfig {
     pub dither_bits: u32,
     /// Kept-sample sum of one half period at the nominal operating point, LSB.
     pub h0_nominal: u32,
-    /// Below this DC (per-half sum) the optical power is flagged low.
+    /// Dark level of one half period's kept-sample sum, LSB.
+    pub dark_half: u32,
+    /// Below this DC (per-half sum above dark) the optical power is flagged low.
     pub h0_min: u32,
     /// Residual beyond which a step counts toward loss of lock, phase LSB.
     pub lock_limit: u32,
@@ -139,7 +148,8 @@ impl FogConfig {
             && finite_pos(p.wavelength_m)
             && finite_pos(p.tau_s)
             && finite_pos(p.closure_hz)
-            && finite_pos(p.nominal_dc_lsb))
+            && finite_pos(p.nominal_dc_lsb)
+            && p.dark_lsb.is_finite())
         {
             return Err(ConfigError::Physical);
         }
@@ -147,7 +157,7 @@ impl FogConfig {
         let n_half = halves.round() as usize;
         if (halves - n_half as f64).abs() > 1e-6
             || n_half < 2
-            || !n_half.is_multiple_of(2)
+            || !n_half.is_multiple_of(4)
             || n_half > MAX_HALF
         {
             return Err(ConfigError::HalfPeriods);
@@ -158,7 +168,8 @@ impl FogConfig {
         {
             return Err(ConfigError::Samples);
         }
-        if !(p.phi0_rad > 0.0 && p.phi0_rad < PI) {
+        // Near 0 or pi the error slope vanishes and cot(phi0) explodes.
+        if !(p.phi0_rad >= 0.1 && p.phi0_rad <= PI - 0.1) {
             return Err(ConfigError::Phi0);
         }
         if !(p.loop_gain > 0.0
@@ -188,7 +199,13 @@ impl FogConfig {
             * 65_536.0
             * 65_536.0
             * crate::RAD_PER_PHASE_LSB;
-        let vib_shift = 24;
+        // Largest scale (at most 2^24) that keeps |coeff| below 2^22, so the
+        // product with two slopes (2^40) cannot overflow an i64.
+        let mut vib_shift = 24;
+        while vib_shift > 0 && coeff_real.abs() * (1u64 << vib_shift) as f64 >= (1u64 << 22) as f64
+        {
+            vib_shift -= 1;
+        }
         let vib_coeff = (coeff_real * (1u64 << vib_shift) as f64).round() as i64;
 
         let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU;
@@ -202,7 +219,7 @@ impl FogConfig {
             phi0: phase_from_rad(p.phi0_rad),
             k_meas_q8: (k_meas * 256.0).round() as u64,
             loop_gain_q16: (p.loop_gain * 65_536.0).round() as i64,
-            gain_loop_q16: (gain_loop * 65_536.0).round() as i64,
+            gain_loop_q16: ((gain_loop * 65_536.0).round() as i64).clamp(0, (1 << 42) - 1),
             cpt_nominal_q8: p.dac_codes_per_turn << 8,
             cpt_min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
             cpt_max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
@@ -212,6 +229,7 @@ impl FogConfig {
             dither_bits: p.dither_bits.min(30),
             h0_nominal: h0_nominal.round() as u32,
             h0_min: (h0_nominal * 0.25).round() as u32,
+            dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,
             lock_limit: phase_from_rad(0.5 * PI),
             lock_steps: 8,
         })

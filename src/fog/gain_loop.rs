@@ -6,25 +6,28 @@
 //! `sum_j w_j*sign_j*(h_j - H)` over the reset half periods is proportional to +g;
 //! integrating it against the digital gain (codes per turn) keeps a reset exactly 2*pi.
 
-use super::modulator::Resets;
+use super::demod::DemodSums;
+use super::modulator::Carries;
 
-/// Returns sum_j w_j * sign_j * (h_j - mean(h)) over the half periods with a reset.
+/// Returns sum_j w_j * (h_j - mean(h)) over the step, w_j = reset direction
+/// times modulation sign (see [`Carries::weight`]), from the demodulator's
+/// sums: over plus halves sum(w*h) = carried - [negative]*all, over minus
+/// halves [negative]*all - carried. |result| < 2^27 (kept sums below 2^20,
+/// at most 64 half periods).
 #[inline(always)]
-pub fn reset_error(halves: &[u32], resets: Resets, dc: u32) -> i32 {
-    let n = halves.len() as u32;
-    let mean = (dc / n.max(1)) as i32;
-    let mut acc = 0i32;
-    let mut bits = resets.up | resets.down;
-    while bits != 0 {
-        let j = bits.trailing_zeros();
-        bits &= bits - 1;
-        if let Some(&h) = halves.get(j as usize) {
-            let dev = h as i32 - mean;
-            let w_sign_positive = ((resets.up >> j) & 1 == 1) == j.is_multiple_of(2);
-            acc += if w_sign_positive { dev } else { -dev };
-        }
-    }
-    acc
+pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
+    let pairs = (n_half / 2) as i32;
+    let (neg_p, neg_m) = (carries.plus_negative as i32, carries.minus_negative as i32);
+    // Plus and minus totals from dc = P + M and P - M = first + second.
+    let diff = sums.first + sums.second;
+    let plus_all = (sums.dc as i32 + diff) / 2;
+    let minus_all = (sums.dc as i32 - diff) / 2;
+    let weighted =
+        sums.carried_plus as i32 - neg_p * plus_all + neg_m * minus_all - sums.carried_minus as i32;
+    let w_sum = carries.plus.count_ones() as i32 - carries.minus.count_ones() as i32
+        + (neg_m - neg_p) * pairs;
+    let mean = (sums.dc / n_half.max(1)) as i32;
+    weighted - mean * w_sum
 }
 
 /// New digital gain (DAC codes per turn, Q8) after one step's reset error.
@@ -32,8 +35,9 @@ pub fn reset_error(halves: &[u32], resets: Resets, dc: u32) -> i32 {
 /// `recip_h`: 2^32 / H (H = DC of one half period's kept samples).
 #[inline(always)]
 pub fn update(cpt_q8: u32, err: i32, gain_q16: i64, recip_h: u32, min: u32, max: u32) -> u32 {
-    // err < 2^21, gain_q16 < 2^40: the product is below 2^61.
-    let scaled = (err as i64 * gain_q16) >> 16;
+    // |err| <= 2^20 (beyond is not a gain error but a lost loop), gain_q16 < 2^42
+    // (config): the product stays below 2^62.
+    let scaled = (err.clamp(-(1 << 20), 1 << 20) as i64 * gain_q16) >> 16;
     let delta = (scaled.clamp(-(1 << 30), 1 << 30) * recip_h as i64) >> 32;
     (cpt_q8 as i64 - delta).clamp(min as i64, max as i64) as u32
 }

@@ -16,13 +16,18 @@
 
 use crate::Phase;
 
-/// Which half periods of a step carry a 2*pi reset, and in which direction.
+/// Where the drive phase carried out of the u32 (wrapped) in one step.
+/// Bit i (counted from bit `pairs - 1` down to 0) is pair i's plus or minus
+/// half period. Whether a carry is a reset depends on the increment's sign,
+/// fixed for all plus (or all minus) halves of a step: see [`Carries::resets`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Resets {
-    /// Bit j: theta overflowed upward (the DAC code fell by about a turn).
-    pub up: u64,
-    /// Bit j: theta underflowed (the DAC code rose by about a turn).
-    pub down: u64,
+pub struct Carries {
+    pub plus: u32,
+    pub minus: u32,
+    /// The plus (minus) halves' increment is negative: there a reset is a
+    /// missing carry (theta wrapped downward), elsewhere a carry (upward).
+    pub plus_negative: bool,
+    pub minus_negative: bool,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -32,50 +37,58 @@ pub struct Modulator {
 }
 
 impl Modulator {
-    /// Writes the DAC words of the next step (one per half period, starting on +phi0)
-    /// and says where the resets fall.
-    /// `step`: feedback step (phase LSB, taken modulo a turn). `cpt_q8`: DAC codes
-    /// per turn in Q8.
+    /// Writes the DAC words of the next step (one per half period, starting on
+    /// +phi0) and returns where the drive phase carried (the 2*pi resets).
+    /// `step`: feedback step (phase LSB, taken modulo a turn); `depth`: this
+    /// step's phi0 (+ dither), phase LSB; `cpt_q8`: DAC codes per turn, Q8.
+    /// At most 64 half periods (32 pairs) are written.
     #[inline(always)]
-    /// `depth`: this step's modulation depth phi0 (+ dither), phase LSB.
     pub fn write_step(
         &mut self,
         step: Phase,
         depth: Phase,
         cpt_q8: u32,
         dac: &mut [u16],
-    ) -> Resets {
-        let d_plus = depth.wrapping_sub(step) as i32;
-        let d_minus = 0u32.wrapping_sub(depth).wrapping_sub(step) as i32;
-        let mut plus_wraps = 0u64;
-        let mut minus_wraps = 0u64;
-        let mut theta = self.theta;
+    ) -> Carries {
+        let d_plus = depth.wrapping_sub(step);
+        let d_minus = 0u32.wrapping_sub(depth).wrapping_sub(step);
         let cpt = cpt_q8 as u64;
-        for (j, pair) in dac.chunks_exact_mut(2).enumerate() {
-            if let [plus, minus] = pair {
-                let (t, ov) = theta.overflowing_add_signed(d_plus);
-                plus_wraps |= (ov as u64) << (2 * j);
-                // u32 * (<2^24) >> 40 stays below 2^16 while cpt_q8 < 2^24 (config clamps it).
-                *plus = ((t as u64 * cpt) >> 40) as u16;
-                let (t2, ov2) = t.overflowing_add_signed(d_minus);
-                minus_wraps |= (ov2 as u64) << (2 * j + 1);
-                *minus = ((t2 as u64 * cpt) >> 40) as u16;
-                theta = t2;
+        let mut theta = self.theta;
+        let (mut plus, mut minus) = (0u32, 0u32);
+        for pair in dac.chunks_exact_mut(2).take(32) {
+            let (t1, c1) = theta.overflowing_add(d_plus);
+            let (t2, c2) = t1.overflowing_add(d_minus);
+            theta = t2;
+            plus = (plus << 1) | c1 as u32;
+            minus = (minus << 1) | c2 as u32;
+            // u32 * (<2^24) >> 40 stays below 2^16 while cpt_q8 < 2^24 (config clamps it).
+            if let [p, m] = pair {
+                *p = ((t1 as u64 * cpt) >> 40) as u16;
+                *m = ((t2 as u64 * cpt) >> 40) as u16;
             }
         }
         self.theta = theta;
-        // An overflow while adding a positive increment is an upward reset.
-        let (mut up, mut down) = (0, 0);
-        if d_plus >= 0 {
-            up |= plus_wraps
-        } else {
-            down |= plus_wraps
+        Carries {
+            plus,
+            minus,
+            plus_negative: (d_plus as i32) < 0,
+            minus_negative: (d_minus as i32) < 0,
         }
-        if d_minus >= 0 {
-            up |= minus_wraps
+    }
+}
+
+impl Carries {
+    /// Reset weight w_j = r_j * sign_j of half period j of a step of `n_half`
+    /// (r_j = +1 upward reset, -1 downward, 0 none; sign +1 on plus halves).
+    pub fn weight(&self, j: usize, n_half: usize) -> i32 {
+        let pairs = n_half / 2;
+        let bit = pairs.wrapping_sub(1 + j / 2) as u32;
+        if j % 2 == 0 {
+            let c = (self.plus.checked_shr(bit).unwrap_or(0) & 1) as i32;
+            c - self.plus_negative as i32
         } else {
-            down |= minus_wraps
+            let c = (self.minus.checked_shr(bit).unwrap_or(0) & 1) as i32;
+            self.minus_negative as i32 - c
         }
-        Resets { up, down }
     }
 }

@@ -35,10 +35,10 @@ impl VibrationCorrection {
     #[inline(always)]
     pub fn update(&mut self, slope: i32, coeff: i64, shift: u32) -> i64 {
         let slope = slope.clamp(-SLOPE_LIMIT, SLOPE_LIMIT);
-        // |product| < 2^40, |coeff| < 2^23 at any phi0 in (0.1, pi-0.1): < 2^63.
+        // |product| <= 2^40 and |coeff| < 2^22 (config picks `shift` so): < 2^62.
         let product = slope as i64 * self.prev_slope as i64;
         self.prev_slope = slope;
-        let bias_q16 = product.saturating_mul(coeff) >> shift;
+        let bias_q16 = (product * coeff) >> shift;
         let total = self.frac_q16 + bias_q16;
         let whole = total >> 16;
         self.frac_q16 = total - (whole << 16);

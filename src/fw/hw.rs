@@ -19,6 +19,7 @@ use super::{stack, uart, FrameQueue, STEPS_PER_FRAME};
 use core::cell::RefCell;
 use cortex_m::interrupt::Mutex;
 use defmt_rtt as _;
+use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
 use gyro_sp::fog::{Faults, FogConfig, FogLoop, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
 use heapless::spsc::Producer;
@@ -39,6 +40,7 @@ struct Ctx {
     tx: Producer<'static, Frame, 8>,
     counter: u32,
     dma: pac::DMA2,
+    adc: pac::ADC1,
 }
 
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
@@ -105,6 +107,16 @@ pub fn run() -> ! {
 
     // ADC1: 12 bit left-aligned, external trigger TIM2 TRGO (EXTSEL 0110), DMA circular.
     dp.ADC1.smpr2().write(|w| unsafe { w.bits(0b001) }); // 15 cycles on IN0
+                                                         // Analog watchdog on every regular conversion: flags codes outside the core's
+                                                         // window [AWD_LOW, AWD_HIGH) (12-bit codes 1 ..= 0xFFD), so the closure does
+                                                         // not search 64 samples for rails.
+    dp.ADC1
+        .ltr()
+        .write(|w| unsafe { w.bits(u32::from(AWD_LOW >> 4)) });
+    dp.ADC1
+        .htr()
+        .write(|w| unsafe { w.bits(u32::from((AWD_HIGH >> 4) - 1)) });
+    dp.ADC1.cr1().write(|w| unsafe { w.bits(1 << 23) }); // AWDEN, all channels
     dp.ADC1.sqr3().write(|w| unsafe { w.bits(0) });
     dp.ADC1.cr2().write(|w| unsafe {
         w.bits((1 << 28) | (0b0110 << 24) | (1 << 11) | (1 << 9) | (1 << 8) | 1)
@@ -152,6 +164,7 @@ pub fn run() -> ! {
             tx,
             counter: 0,
             dma: dp.DMA2,
+            adc: dp.ADC1,
         }))
     });
     unsafe {
@@ -215,7 +228,11 @@ fn DMA2_STREAM0() {
         ) else {
             return;
         };
-        let out = ctx.fog.process(&ctx.cfg, adc, dac);
+        // AWD is sticky: read and clear it once per step (a conversion of the
+        // step now sampling may be counted with this one; that errs safe).
+        let over_range = ctx.adc.sr().read().bits() & 1 != 0;
+        ctx.adc.sr().write(|w| unsafe { w.bits(!1) });
+        let out = ctx.fog.process(&ctx.cfg, adc, over_range, dac);
         ctx.counter = ctx.counter.wrapping_add(1);
         if let Some(f) = ctx.frames.push(&out, ctx.counter) {
             if let Err(f) = ctx.tx.enqueue(f) {

@@ -53,12 +53,8 @@ pub fn run() -> ! {
     let ipt = instructions_per_tick(&mut cp.SYST);
 
     let mut optics = OpticsParams::<f32>::nominal(5e-6, 4, 49_152);
-    let phi0 = 0.75 * core::f64::consts::PI;
-    let params = FogParams {
-        nominal_dc_lsb: optics.operating_dc(phi0 as f32) as f64,
-        ..FogParams::default()
-    };
     optics.adc_bits = 12;
+    let params = optics.matched(FogParams::default());
     let Ok(cfg) = FogConfig::new(params) else {
         fail()
     };

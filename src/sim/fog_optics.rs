@@ -46,7 +46,7 @@ impl<F: Float> OpticsParams<F> {
         let f = |x: f64| F::from(x).unwrap_or(F::zero());
         Self {
             peak_lsb: f(58_000.0),
-            adc_offset_lsb: f(0.0),
+            adc_offset_lsb: f(1_024.0),
             adc_bits: 12,
             detector_tau_s: f(0.15e-6),
             tau_s,
@@ -62,9 +62,22 @@ impl<F: Float> OpticsParams<F> {
         }
     }
 
-    /// DC of one sample at the operating point (residual 0), LSB.
-    pub fn operating_dc(&self, phi0_rad: F) -> F {
-        self.adc_offset_lsb + self.peak_lsb / (F::one() + F::one()) * (F::one() + phi0_rad.cos())
+    /// Detector level of one sample at the operating point (residual 0) above
+    /// the dark level, LSB.
+    pub fn operating_light(&self, phi0_rad: F) -> F {
+        self.peak_lsb / (F::one() + F::one()) * (F::one() + phi0_rad.cos())
+    }
+
+    /// `params` with the front-end levels this detector has (nominal DC, dark level).
+    pub fn matched(&self, params: crate::fog::FogParams) -> crate::fog::FogParams {
+        crate::fog::FogParams {
+            nominal_dc_lsb: self
+                .operating_light(F::from(params.phi0_rad).unwrap_or(F::zero()))
+                .to_f64()
+                .unwrap_or(0.0),
+            dark_lsb: self.adc_offset_lsb.to_f64().unwrap_or(0.0),
+            ..params
+        }
     }
 }
 
@@ -98,8 +111,11 @@ where
 
     /// Simulates one closure step: DAC words `dac` (one per half period) applied
     /// while the Sagnac phase is `sagnac[j]` (rad) in half period j; writes the
-    /// ADC samples into `adc` (`samples_per_half` per half period).
-    pub fn run_step(&mut self, dac: &[u16], sagnac: &[F], adc: &mut [u16]) {
+    /// ADC samples into `adc` (`samples_per_half` per half period). Returns the
+    /// ADC analog-watchdog flag: a conversion fell outside [AWD_LOW, AWD_HIGH].
+    pub fn run_step(&mut self, dac: &[u16], sagnac: &[F], adc: &mut [u16]) -> bool {
+        use crate::fog::demod::{AWD_HIGH, AWD_LOW};
+        let mut watchdog = false;
         let p = self.p;
         let two = F::one() + F::one();
         let gain = F::one() + p.vpi_gain_error + p.vpi_drift_per_s * self.elapsed_s;
@@ -123,8 +139,10 @@ where
                 }
                 let v = ((p.adc_offset_lsb + y) / lsb).round() * lsb;
                 *s = v.max(F::zero()).min(top).to_u16().unwrap_or(0);
+                watchdog |= !(AWD_LOW..AWD_HIGH).contains(s);
             }
         }
         self.elapsed_s = self.elapsed_s + p.tau_s * F::from(dac.len()).unwrap_or(F::zero());
+        watchdog
     }
 }

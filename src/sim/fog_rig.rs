@@ -17,6 +17,8 @@ pub struct FogRig<F> {
     dac: [u16; MAX_HALF],
     adc: [u16; MAX_HALF * MAX_SAMPLES_PER_HALF],
     sagnac: [F; MAX_HALF],
+    /// The ADC analog watchdog fired during the last simulated step.
+    adc_over_range: bool,
 }
 
 /// One step of the rig: the core's output and the truth.
@@ -47,6 +49,7 @@ where
             dac,
             adc: [0; MAX_HALF * MAX_SAMPLES_PER_HALF],
             sagnac: [F::zero(); MAX_HALF],
+            adc_over_range: false,
         }
     }
 
@@ -77,7 +80,7 @@ where
         }
         let ns = self.cfg.n_samples;
         let (dac, adc, sagnac) = (&self.dac[..n], &mut self.adc[..ns], &self.sagnac[..n]);
-        self.optics.run_step(dac, sagnac, adc);
+        self.adc_over_range = self.optics.run_step(dac, sagnac, adc);
         sum / F::from(n).unwrap_or(F::one())
     }
 
@@ -86,8 +89,12 @@ where
     #[inline(never)]
     pub fn process_core(&mut self) -> ClosureOutput {
         let (n, ns) = (self.cfg.n_half, self.cfg.n_samples);
-        self.fog
-            .process(&self.cfg, &self.adc[..ns], &mut self.dac[..n])
+        self.fog.process(
+            &self.cfg,
+            &self.adc[..ns],
+            self.adc_over_range,
+            &mut self.dac[..n],
+        )
     }
 
     /// Completes a step run as `simulate_optics` + `process_core`.
