@@ -26,7 +26,7 @@ pub struct FogArgs {
     #[arg(long, default_value_t = 12_500.0)]
     pub closure_hz: f64,
     /// Constant input rate, deg/s.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub rate_dps: f64,
     /// Peak angular acceleration of a sinusoidal oscillation, deg/s^2.
     #[arg(long, requires = "vibration_hz")]
@@ -53,14 +53,14 @@ pub struct FogArgs {
     #[arg(long, default_value_t = 0.05)]
     pub gain_loop_gain: f64,
     /// Modulator gain error (V_pi off nominal), relative.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub vpi_error: f64,
     /// ADC resolution, bits.
     #[arg(long, default_value_t = 12)]
     pub adc_bits: u32,
-    /// Modulation-depth dither width, bits of phase (0 = off).
-    #[arg(long, default_value_t = 27)]
-    pub dither_bits: u32,
+    /// Modulation-depth dither, half width in ADC codes of the detector level (0 = off).
+    #[arg(long, default_value_t = 60.0)]
+    pub dither_codes: f64,
     /// Start-up time left out of the mean error, s.
     #[arg(long, default_value_t = 0.02)]
     pub settle_s: f64,
@@ -133,7 +133,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
         closure_hz: a.closure_hz,
         loop_gain: a.loop_gain,
         gain_loop_gain: a.gain_loop_gain,
-        dither_bits: a.dither_bits,
+        dither_adc_codes: a.dither_codes,
         vibration_correction: !a.no_vibration_correction,
         ..FogParams::default()
     };

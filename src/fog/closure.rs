@@ -83,7 +83,9 @@ impl FogLoop {
         }
     }
 
-    /// phi0 plus a uniform dither in [-2^(dither_bits-1), 2^(dither_bits-1)) LSB.
+    /// phi0 plus a uniform dither in [-2^(dither_bits-1), 2^(dither_bits-1)) LSB
+    /// (xorshift32; a golden-ratio sequence was tried and its lines beat with
+    /// the reset pattern at some rates).
     #[inline(always)]
     fn next_depth(&mut self, cfg: &FogConfig) -> u32 {
         let mut x = self.dither;

@@ -36,10 +36,14 @@ pub struct FogParams {
     pub gain_loop_gain: f64,
     /// DAC codes that give 2*pi at the modulator at nominal V_pi.
     pub dac_codes_per_turn: u32,
-    /// Depth dither: uniform over 2^dither_bits phase LSB (0 = off); 27 bits is
-    /// +-0.1 rad, about +-120 codes of a 12-bit ADC at the operating point: enough
-    /// to average its rounding below 0.2 ppm of scale factor (25 bits left 1 ppm).
-    pub dither_bits: u32,
+    /// Depth dither, half width in ADC codes of the half-period level at the
+    /// operating point (0 = off). 60 codes of a 12-bit ADC (+-0.05 rad) average
+    /// its rounding to about 0.5 ppm of scale factor at 50 deg/s; the width in
+    /// phase follows the ADC, so a finer ADC gets a smaller dither and the
+    /// epsilon-squared coefficient (it depends on the depth) moves less.
+    pub dither_adc_codes: f64,
+    /// ADC resolution, bits (left-aligned in 16).
+    pub adc_bits: u32,
     /// Online epsilon-squared correction on.
     pub vibration_correction: bool,
     /// Expected DC level of one kept ADC sample at the operating point, above
@@ -67,7 +71,8 @@ impl Default for FogParams {
             loop_gain: 1.0,
             gain_loop_gain: 0.05,
             dac_codes_per_turn: 49_152,
-            dither_bits: 27,
+            dither_adc_codes: 60.0,
+            adc_bits: 12,
             vibration_correction: true,
             nominal_dc_lsb: 8_000.0,
             dark_lsb: 1_024.0,
@@ -208,6 +213,17 @@ impl FogConfig {
         }
         let vib_coeff = (coeff_real * (1u64 << vib_shift) as f64).round() as i64;
 
+        // Dither: +-codes * (ADC LSB) of level, at A*sin(phi0) level per rad.
+        let amplitude = p.nominal_dc_lsb / (1.0 + p.phi0_rad.cos());
+        let code_lsb = (1u32 << (16 - p.adc_bits.clamp(1, 16))) as f64;
+        let half_width_rad =
+            p.dither_adc_codes.max(0.0) * code_lsb / (amplitude * p.phi0_rad.sin());
+        let dither_bits = if p.dither_adc_codes > 0.0 {
+            ((2.0 * half_width_rad * lsb_per_rad).log2().round() as u32).clamp(1, 28)
+        } else {
+            0
+        };
+
         let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU;
         Ok(Self {
             params: p,
@@ -226,7 +242,7 @@ impl FogConfig {
             vib_coeff,
             vib_shift,
             vibration_correction: p.vibration_correction,
-            dither_bits: p.dither_bits.min(30),
+            dither_bits,
             h0_nominal: h0_nominal.round() as u32,
             h0_min: (h0_nominal * 0.25).round() as u32,
             dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,

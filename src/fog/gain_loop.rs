@@ -9,8 +9,9 @@
 use super::demod::DemodSums;
 use super::modulator::Carries;
 
-/// Returns sum_j w_j * (h_j - mean(h)) over the step, w_j = reset direction
-/// times modulation sign (see [`Carries::weight`]), from the demodulator's
+/// Returns sum_j w_j * (h_j - mean(h)) - r_j * e over the step, w_j = r_j *
+/// sign_j, r_j the reset direction (see [`Carries::weight`]) and e the step's
+/// mean of sign_j * h_j, from the demodulator's
 /// sums: over plus halves sum(w*h) = carried - [negative]*all, over minus
 /// halves [negative]*all - carried. |result| < 2^27 (kept sums below 2^20,
 /// at most 64 half periods).
@@ -27,7 +28,15 @@ pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
     let w_sum = carries.plus.count_ones() as i32 - carries.minus.count_ones() as i32
         + (neg_m - neg_p) * pairs;
     let mean = (sums.dc / n_half.max(1)) as i32;
-    weighted - mean * w_sum
+    // The step's common residual (mean of sign_j*h_j, e.g. the phase dither or
+    // the lag under acceleration) shows at every half period, reset or not;
+    // taken out per reset (sum of reset directions r_sum) so that only the
+    // reset's own phase error remains: the number of resets in a step
+    // correlates with the dither and the rate, and would bias the gain.
+    let r_sum =
+        (carries.plus.count_ones() + carries.minus.count_ones()) as i32 - (neg_p + neg_m) * pairs;
+    let common = (diff * r_sum) / n_half.max(1) as i32;
+    weighted - mean * w_sum - common
 }
 
 /// New digital gain (DAC codes per turn, Q8) after one step's reset error.

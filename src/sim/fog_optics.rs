@@ -76,6 +76,7 @@ impl<F: Float> OpticsParams<F> {
                 .to_f64()
                 .unwrap_or(0.0),
             dark_lsb: self.adc_offset_lsb.to_f64().unwrap_or(0.0),
+            adc_bits: self.adc_bits,
             ..params
         }
     }
