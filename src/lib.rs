@@ -12,6 +12,7 @@
 
 pub mod fog;
 pub mod frame;
+pub mod rlg;
 pub mod sim;
 
 /// Phase with one turn = 2^32 LSB (wrapping arithmetic is the 2*pi reset).

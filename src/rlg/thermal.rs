@@ -1,0 +1,192 @@
+//! Thermal bias compensation (physics.md 2.3), fixed point:
+//! `B_TC = bias0 + K1*dT + K2*grad(dT) + K3*dT^2 + K4*T_K + K5*F(tau)`.
+//!
+//! Formats:
+//! - temperatures: i32, Q8 degC (1/256 degC; TMP117's LSB is 1/128 degC);
+//! - dT = T_a - T_b: Q8 degC; grad(dT): Q32 degC/s (state precision: a Q16
+//!   state's truncation biased the term by 0.03 deg/h) from a filtered
+//!   differentiator `s/(1 + tau_g*s)` (tau_g = 20 s) run at the sensor rate,
+//!   its input clamped to +-8 degC/s;
+//! - F(tau) = 1 - exp(-t/tau_warm): Q30, advanced recursively
+//!   (`F += a*(1 - F)`, a = 1 - exp(-dt/tau_warm)), no exp on the target;
+//! - coefficients: Q24 deg/h per unit (Q16 cost 3e-4 deg/h on K4*T_K at
+//!   40 degC); every term and B_TC: Q16 deg/h in i64. |coeff| <= 1e3 (2^34 in
+//!   Q24), |dT| clamped to 32 degC and temperatures within -55..150 degC keep
+//!   every product below 2^61.
+//!
+//! Sensor faults: a read that failed (NACK, timeout), reads outside
+//! -55..+150 degC or repeats the exact same value for [`STUCK_READS`] reads
+//! marks that sensor bad; the compensation then holds that sensor's last good
+//! value (and the gradient decays to 0), and the flag stays up while it lasts.
+
+use super::coeffs::ThermalCoeffs;
+
+/// Identical consecutive reads that mark a sensor stuck (TMP117 noise moves the
+/// last bit within a few reads; 64 reads at 8 Hz is 8 s).
+pub const STUCK_READS: u16 = 64;
+const T_MIN_Q8: i32 = -55 * 256;
+const T_MAX_Q8: i32 = 150 * 256;
+/// Gradient filter time constant, s.
+pub const GRAD_TAU_S: f64 = 20.0;
+
+/// One set of sensor reads, Q8 degC; `None`: the read failed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Temperatures {
+    pub mono_a_q8: Option<i32>,
+    pub mono_b_q8: Option<i32>,
+    pub case_q8: Option<i32>,
+}
+
+/// Fault bits of the thermal channel.
+pub mod flags {
+    pub const SENSOR_A: u8 = 1 << 0;
+    pub const SENSOR_B: u8 = 1 << 1;
+    pub const SENSOR_CASE: u8 = 1 << 2;
+    /// The stored coefficients were refused: running on `ThermalCoeffs::SAFE`.
+    pub const COEFFS_DEFAULT: u8 = 1 << 3;
+}
+
+/// Immutable fixed-point form of the coefficients for one sensor update period.
+#[derive(Clone, Copy, Debug)]
+pub struct ThermalConfig {
+    bias0_q24: i64,
+    k1_q24: i64,
+    k2_q24: i64,
+    k3_q24: i64,
+    k4_q24: i64,
+    k5_q24: i64,
+    /// 1/dt in Q16 per s.
+    inv_dt_q16: i64,
+    /// Gradient filter weight dt/(tau_g + dt), Q30.
+    grad_a_q30: i64,
+    /// Warm-up step 1 - exp(-dt/tau_warm), Q30.
+    warm_a_q30: i64,
+    pub coeffs_default: bool,
+}
+
+impl ThermalConfig {
+    /// `dt_s`: sensor update period. Refused coefficients fall back to SAFE.
+    pub fn new(c: &ThermalCoeffs, dt_s: f64) -> Self {
+        let (c, coeffs_default) = match c.check() {
+            Ok(()) => (*c, false),
+            Err(_) => (ThermalCoeffs::SAFE, true),
+        };
+        // Sensor period 1 ms .. 1 s (the gradient filter's headroom assumes it).
+        let dt = if dt_s.is_finite() && dt_s > 1e-3 {
+            dt_s.min(1.0)
+        } else {
+            1.0
+        };
+        let q16 = |x: f64| (x * 65_536.0).round() as i64;
+        let q24 = |x: f64| (x * 16_777_216.0).round() as i64;
+        let q30 = |x: f64| (x * (1u64 << 30) as f64).round() as i64;
+        Self {
+            bias0_q24: q24(c.bias0_dph),
+            k1_q24: q24(c.k1_dph_per_c),
+            k2_q24: q24(c.k2_dph_per_c_per_s),
+            k3_q24: q24(c.k3_dph_per_c2),
+            k4_q24: q24(c.k4_dph_per_c),
+            k5_q24: q24(c.k5_dph),
+            inv_dt_q16: q16(1.0 / dt),
+            grad_a_q30: q30(dt / (GRAD_TAU_S + dt)),
+            warm_a_q30: q30(1.0 - num_traits::float::Float::exp(-dt / c.tau_warm_s)),
+            coeffs_default,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Sensor {
+    last_good_q8: i32,
+    last_raw: Option<i32>,
+    repeats: u16,
+    seen: bool,
+}
+
+impl Sensor {
+    /// Returns the value to use and whether the sensor is bad.
+    fn take(&mut self, read: Option<i32>) -> (i32, bool) {
+        let bad = match read {
+            Some(t) if (T_MIN_Q8..=T_MAX_Q8).contains(&t) => {
+                if self.last_raw == Some(t) {
+                    self.repeats = self.repeats.saturating_add(1);
+                } else {
+                    self.repeats = 0;
+                }
+                self.last_raw = Some(t);
+                if self.repeats < STUCK_READS {
+                    self.last_good_q8 = t;
+                    self.seen = true;
+                    false
+                } else {
+                    true
+                }
+            }
+            _ => true,
+        };
+        (self.last_good_q8, bad || !self.seen)
+    }
+}
+
+/// Mutable state of the compensation.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ThermalComp {
+    a: Sensor,
+    b: Sensor,
+    case: Sensor,
+    prev_dt_q8: Option<i32>,
+    grad_q32: i64,
+    warm_q30: i64,
+    bias_q16: i64,
+    flags: u8,
+}
+
+impl ThermalComp {
+    /// One sensor update: returns B_TC (constant bias included), Q16 deg/h.
+    pub fn update(&mut self, cfg: &ThermalConfig, t: &Temperatures) -> i64 {
+        let (ta, bad_a) = self.a.take(t.mono_a_q8);
+        let (tb, bad_b) = self.b.take(t.mono_b_q8);
+        let (tk, bad_k) = self.case.take(t.case_q8);
+        self.flags = (bad_a as u8) * flags::SENSOR_A
+            | (bad_b as u8) * flags::SENSOR_B
+            | (bad_k as u8) * flags::SENSOR_CASE
+            | (cfg.coeffs_default as u8) * flags::COEFFS_DEFAULT;
+
+        let dt = ((ta - tb) as i64).clamp(-32 * 256, 32 * 256); // Q8
+                                                                // Differentiator input: 0 while either monoblock sensor is bad (held
+                                                                // values carry no rate), so the gradient decays instead of jumping.
+        const SLOPE_LIMIT_Q32: i64 = 8 << 32;
+        let slope_q32 = match self.prev_dt_q8 {
+            Some(p) if !(bad_a || bad_b) => ((dt - p as i64) * cfg.inv_dt_q16) << 8,
+            _ => 0,
+        }
+        .clamp(-SLOPE_LIMIT_Q32, SLOPE_LIMIT_Q32);
+        self.prev_dt_q8 = Some(dt as i32);
+        // |slope - grad| < 2^36, a < 2^26 (dt <= 1 s): below 2^62. Rounded shifts.
+        const HALF: i64 = 1 << 29;
+        self.grad_q32 += ((slope_q32 - self.grad_q32) * cfg.grad_a_q30 + HALF) >> 30;
+        self.warm_q30 += (((1i64 << 30) - self.warm_q30) * cfg.warm_a_q30 + HALF) >> 30;
+
+        let b = (cfg.bias0_q24 >> 8)
+            + ((cfg.k1_q24 * dt) >> 16)
+            + ((cfg.k2_q24 * (self.grad_q32 >> 12)) >> 28)
+            + ((cfg.k3_q24 * (dt * dt)) >> 24)
+            + ((cfg.k4_q24 * tk as i64) >> 16)
+            + ((cfg.k5_q24 * (self.warm_q30 >> 6)) >> 32);
+        self.bias_q16 = b;
+        b
+    }
+
+    /// Last B_TC, Q16 deg/h.
+    pub fn bias_q16(&self) -> i64 {
+        self.bias_q16
+    }
+    /// Fault bits ([`flags`]).
+    pub fn flags(&self) -> u8 {
+        self.flags
+    }
+    /// Filtered d(dT)/dt, Q32 degC/s.
+    pub fn gradient_q32(&self) -> i64 {
+        self.grad_q32
+    }
+}
