@@ -83,7 +83,7 @@ impl Carries {
     pub fn weight(&self, j: usize, n_half: usize) -> i32 {
         let pairs = n_half / 2;
         let bit = pairs.wrapping_sub(1 + j / 2) as u32;
-        if j % 2 == 0 {
+        if j.is_multiple_of(2) {
             let c = (self.plus.checked_shr(bit).unwrap_or(0) & 1) as i32;
             c - self.plus_negative as i32
         } else {

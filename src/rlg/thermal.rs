@@ -147,10 +147,11 @@ impl ThermalComp {
         let (ta, bad_a) = self.a.take(t.mono_a_q8);
         let (tb, bad_b) = self.b.take(t.mono_b_q8);
         let (tk, bad_k) = self.case.take(t.case_q8);
-        self.flags = (bad_a as u8) * flags::SENSOR_A
-            | (bad_b as u8) * flags::SENSOR_B
-            | (bad_k as u8) * flags::SENSOR_CASE
-            | (cfg.coeffs_default as u8) * flags::COEFFS_DEFAULT;
+        let bit = |on: bool, b: u8| if on { b } else { 0 };
+        self.flags = bit(bad_a, flags::SENSOR_A)
+            | bit(bad_b, flags::SENSOR_B)
+            | bit(bad_k, flags::SENSOR_CASE)
+            | bit(cfg.coeffs_default, flags::COEFFS_DEFAULT);
 
         let dt = ((ta - tb) as i64).clamp(-32 * 256, 32 * 256); // Q8
                                                                 // Differentiator input: 0 while either monoblock sensor is bad (held
