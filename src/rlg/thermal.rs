@@ -20,6 +20,8 @@
 //! value (and the gradient decays to 0), and the flag stays up while it lasts.
 
 use super::coeffs::ThermalCoeffs;
+#[allow(unused_imports)] // f64 maths comes from libm where core lacks it
+use num_traits::float::Float;
 
 /// Identical consecutive reads that mark a sensor stuck (TMP117 noise moves the
 /// last bit within a few reads; 64 reads at 8 Hz is 8 s).
@@ -89,7 +91,7 @@ impl ThermalConfig {
             k5_q24: q24(c.k5_dph),
             inv_dt_q16: q16(1.0 / dt),
             grad_a_q30: q30(dt / (GRAD_TAU_S + dt)),
-            warm_a_q30: q30(1.0 - num_traits::float::Float::exp(-dt / c.tau_warm_s)),
+            warm_a_q30: q30(1.0 - (-dt / c.tau_warm_s).exp()),
             coeffs_default,
         }
     }
