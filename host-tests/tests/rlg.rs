@@ -162,7 +162,6 @@ fn sensor_faults_flag_and_hold() {
             },
         );
     }
-    let _ = stuck;
     assert!(comp.flags() & flags::SENSOR_B != 0);
     // All good again.
     comp.update(&cfg, &good(300));
