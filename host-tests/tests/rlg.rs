@@ -149,10 +149,6 @@ fn sensor_faults_flag_and_hold() {
     comp.update(&cfg, &t);
     assert!(comp.flags() & flags::SENSOR_A != 0);
     // Monoblock B sticks.
-    let stuck = Temperatures {
-        mono_b_q8: Some(4800),
-        ..good(102)
-    };
     for k in 0..=STUCK_READS as i32 {
         comp.update(
             &cfg,
