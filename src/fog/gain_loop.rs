@@ -28,7 +28,7 @@ pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
     let w_sum = carries.plus.count_ones() as i32 - carries.minus.count_ones() as i32
         + (neg_m - neg_p) * pairs;
     let mean = (sums.dc / n_half.max(1)) as i32;
-    // The step's common residual (mean of sign_j*h_j, e.g. the phase dither or
+    // The step's common residual (mean of sign_j*h_j: the main loop's error, or
     // the lag under acceleration) shows at every half period, reset or not;
     // taken out per reset (sum of reset directions r_sum) so that only the
     // reset's own phase error remains: the number of resets in a step

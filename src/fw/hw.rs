@@ -107,9 +107,10 @@ pub fn run() -> ! {
 
     // ADC1: 12 bit left-aligned, external trigger TIM2 TRGO (EXTSEL 0110), DMA circular.
     dp.ADC1.smpr2().write(|w| unsafe { w.bits(0b001) }); // 15 cycles on IN0
-                                                         // Analog watchdog on every regular conversion: flags codes outside the core's
-                                                         // window [AWD_LOW, AWD_HIGH) (12-bit codes 1 ..= 0xFFD), so the closure does
-                                                         // not search 64 samples for rails.
+
+    // Analog watchdog on every regular conversion: flags codes outside the core's
+    // window [AWD_LOW, AWD_HIGH) (12-bit codes 1 ..= 0xFFD), so the closure does
+    // not search 64 samples for rails.
     dp.ADC1
         .ltr()
         .write(|w| unsafe { w.bits(u32::from(AWD_LOW >> 4)) });
