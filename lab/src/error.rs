@@ -1,4 +1,5 @@
-//! Errors of the lab tool. Usage errors (bad option values) exit with status 2.
+//! Errors of the lab tool. Bad input (options, data files) exits with status 2
+//! and a one-line message naming the file, line and column where that applies.
 
 use std::fmt;
 
@@ -6,6 +7,8 @@ use std::fmt;
 pub enum LabError {
     /// Bad option value.
     Usage(String),
+    /// Bad input file: `file:line:column: message` (line/column where known).
+    Input(String),
     /// Failure writing output.
     Io(String),
 }
@@ -13,7 +16,7 @@ pub enum LabError {
 impl LabError {
     pub fn exit_code(&self) -> u8 {
         match self {
-            LabError::Usage(_) => 2,
+            LabError::Usage(_) | LabError::Input(_) => 2,
             LabError::Io(_) => 1,
         }
     }
@@ -22,10 +25,12 @@ impl LabError {
 impl fmt::Display for LabError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            LabError::Usage(m) | LabError::Io(m) => write!(f, "{m}"),
+            LabError::Usage(m) | LabError::Input(m) | LabError::Io(m) => write!(f, "{m}"),
         }
     }
 }
+
+impl std::error::Error for LabError {}
 
 impl From<std::io::Error> for LabError {
     fn from(e: std::io::Error) -> Self {

@@ -2,8 +2,8 @@
 //! Every subcommand takes `--json`; bad input exits with status 2 and a one-line
 //! error naming the file, line and column.
 
-mod error;
-mod simulate;
+use gyro_lab::error::LabError;
+use gyro_lab::{lockin, simulate};
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +25,17 @@ enum Cmd {
     /// Run the firmware's core against a simulated gyro.
     #[command(subcommand)]
     Simulate(simulate::SimulateCmd),
+    /// RLG lock-in rate from a fringe record (exact harmonic relation).
+    Lockin(lockin::LockinArgs),
+    /// Benchmarks of the estimators on simulated records.
+    #[command(subcommand)]
+    Bench(BenchCmd),
+}
+
+#[derive(Subcommand)]
+enum BenchCmd {
+    /// Lock-in: exact harmonic relation next to the published approximate formula.
+    Lockin(lockin::LockinBenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -38,10 +49,13 @@ fn main() -> ExitCode {
     };
     let result = match cli.cmd {
         Cmd::Simulate(c) => simulate::run(c),
+        Cmd::Lockin(a) => lockin::run(&a),
+        Cmd::Bench(BenchCmd::Lockin(a)) => lockin::bench_run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            let e: LabError = e;
             eprintln!("gyro-lab: {e}");
             ExitCode::from(e.exit_code())
         }

@@ -15,6 +15,8 @@ const DPH_PER_RAD_S: f64 = 3600.0 / DEG;
 pub enum SimulateCmd {
     /// Closed-loop fiber-optic gyro.
     Fog(FogArgs),
+    /// RLG fringe signal near lock-in (writes a fringe file).
+    Lockin(crate::lockin::LockinSimArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -88,6 +90,7 @@ pub struct FogSummary {
 
 pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
     match cmd {
+        SimulateCmd::Lockin(a) => crate::lockin::simulate(&a),
         SimulateCmd::Fog(a) => {
             let s = simulate_fog(&a)?;
             if a.json {

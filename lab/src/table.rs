@@ -1,0 +1,168 @@
+//! Reading run and fringe files (interfaces.md "Data files"): CSV, one header
+//! row, `#` comment lines before it. Every cell the tool uses is checked: a
+//! missing column, a cell that is not a finite number, time that does not
+//! increase or too few rows give `file:line:column: message` (column = 1-based
+//! field number, then its name). Unused columns are kept for write-back.
+
+use crate::error::LabError;
+use std::path::{Path, PathBuf};
+
+/// A data file held as text cells, with the line number of every row.
+pub struct Table {
+    pub path: PathBuf,
+    pub header: Vec<String>,
+    header_line: u64,
+    rows: Vec<(u64, Vec<String>)>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Result<Self, LabError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| LabError::Input(format!("{name}: cannot read: {e}")))?;
+        // Comment lines before the header are skipped by hand so that line
+        // numbers stay those of the file.
+        let mut skipped = 0u64;
+        let mut offset = 0usize;
+        for line in text.split_inclusive('\n') {
+            let t = line.trim();
+            if t.starts_with('#') || t.is_empty() {
+                skipped += 1;
+                offset += line.len();
+            } else {
+                break;
+            }
+        }
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(&text.as_bytes()[offset..]);
+        let mut records = rdr.records();
+        let header: Vec<String> = match records.next() {
+            Some(Ok(r)) => r.iter().map(str::to_owned).collect(),
+            Some(Err(e)) => return Err(LabError::Input(format!("{name}: {e}"))),
+            None => return Err(LabError::Input(format!("{name}: no header row"))),
+        };
+        let header_line = skipped + 1;
+        let mut rows = Vec::new();
+        for rec in records {
+            let rec = rec.map_err(|e| {
+                let line = e.position().map_or(0, |p| p.line() + skipped);
+                LabError::Input(format!("{name}:{line}: {e}"))
+            })?;
+            let line = rec.position().map_or(0, |p| p.line()) + skipped;
+            if rec.iter().all(str::is_empty) {
+                continue;
+            }
+            rows.push((line, rec.iter().map(str::to_owned).collect()));
+        }
+        Ok(Self {
+            path: path.to_owned(),
+            header,
+            header_line,
+            rows,
+        })
+    }
+
+    fn name(&self) -> String {
+        self.path.display().to_string()
+    }
+
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    pub fn has(&self, col: &str) -> bool {
+        self.header.iter().any(|h| h == col)
+    }
+
+    fn index(&self, col: &str) -> Result<usize, LabError> {
+        self.header.iter().position(|h| h == col).ok_or_else(|| {
+            LabError::Input(format!(
+                "{}:{}: missing column `{col}`",
+                self.name(),
+                self.header_line
+            ))
+        })
+    }
+
+    /// A numeric column: every cell a finite number.
+    pub fn column(&self, col: &str) -> Result<Vec<f64>, LabError> {
+        let i = self.index(col)?;
+        self.rows
+            .iter()
+            .map(|(line, cells)| {
+                let cell = cells.get(i).map(String::as_str).unwrap_or("");
+                match cell.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    Ok(_) => Err(format!("`{cell}` is not a finite number")),
+                    Err(_) if cell.is_empty() => Err("empty cell".to_owned()),
+                    Err(_) => Err(format!("cannot read `{cell}` as a number")),
+                }
+                .map_err(|m| {
+                    LabError::Input(format!(
+                        "{}:{line}:{} (column `{col}`): {m}",
+                        self.name(),
+                        i + 1
+                    ))
+                })
+            })
+            .collect()
+    }
+
+    /// An optional numeric column.
+    pub fn column_opt(&self, col: &str) -> Result<Option<Vec<f64>>, LabError> {
+        if self.has(col) {
+            self.column(col).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// The `t_s` column, strictly increasing, with at least `min_rows` rows.
+    pub fn time(&self, min_rows: usize) -> Result<Vec<f64>, LabError> {
+        if self.rows.len() < min_rows {
+            return Err(LabError::Input(format!(
+                "{}: {} data rows, at least {min_rows} needed",
+                self.name(),
+                self.rows.len()
+            )));
+        }
+        let t = self.column("t_s")?;
+        let i = self.index("t_s")?;
+        for k in 1..t.len() {
+            if t[k] <= t[k - 1] {
+                return Err(LabError::Input(format!(
+                    "{}:{}:{} (column `t_s`): time {} does not increase (previous {})",
+                    self.name(),
+                    self.rows[k].0,
+                    i + 1,
+                    t[k],
+                    t[k - 1]
+                )));
+            }
+        }
+        Ok(t)
+    }
+
+    /// Writes the table back with extra numeric columns appended.
+    pub fn write_with(&self, out: &Path, extra: &[(&str, &[f64])]) -> Result<(), LabError> {
+        let io = |e: csv::Error| LabError::Io(format!("{}: {e}", out.display()));
+        let mut w = csv::Writer::from_path(out).map_err(io)?;
+        let mut head = self.header.clone();
+        head.extend(extra.iter().map(|(n, _)| n.to_string()));
+        w.write_record(&head).map_err(io)?;
+        for (k, (_, cells)) in self.rows.iter().enumerate() {
+            let mut rec = cells.clone();
+            rec.extend(extra.iter().map(|(_, v)| format!("{:.9}", v[k])));
+            w.write_record(&rec).map_err(io)?;
+        }
+        w.flush()
+            .map_err(|e| LabError::Io(format!("{}: {e}", out.display())))
+    }
+}
