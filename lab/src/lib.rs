@@ -5,3 +5,4 @@ pub mod error;
 pub mod lockin;
 pub mod simulate;
 pub mod table;
+pub mod thermal;

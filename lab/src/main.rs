@@ -3,7 +3,7 @@
 //! error naming the file, line and column.
 
 use gyro_lab::error::LabError;
-use gyro_lab::{lockin, simulate};
+use gyro_lab::{lockin, simulate, thermal};
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -27,9 +27,20 @@ enum Cmd {
     Simulate(simulate::SimulateCmd),
     /// RLG lock-in rate from a fringe record (exact harmonic relation).
     Lockin(lockin::LockinArgs),
+    /// Calibration fits on test-rig runs.
+    #[command(subcommand)]
+    Fit(FitCmd),
+    /// Apply a coefficient file as the firmware does; adds `rate_comp_dps`.
+    Compensate(thermal::CompensateArgs),
     /// Benchmarks of the estimators on simulated records.
     #[command(subcommand)]
     Bench(BenchCmd),
+}
+
+#[derive(Subcommand)]
+enum FitCmd {
+    /// RLG thermal bias model (two monoblock sensors, case sensor, gradient, warm-up).
+    Thermal(thermal::FitThermalArgs),
 }
 
 #[derive(Subcommand)]
@@ -50,6 +61,8 @@ fn main() -> ExitCode {
     let result = match cli.cmd {
         Cmd::Simulate(c) => simulate::run(c),
         Cmd::Lockin(a) => lockin::run(&a),
+        Cmd::Fit(FitCmd::Thermal(a)) => thermal::fit_run(&a),
+        Cmd::Compensate(a) => thermal::compensate_run(&a),
         Cmd::Bench(BenchCmd::Lockin(a)) => lockin::bench_run(&a),
     };
     match result {

@@ -17,6 +17,8 @@ pub enum SimulateCmd {
     Fog(FogArgs),
     /// RLG fringe signal near lock-in (writes a fringe file).
     Lockin(crate::lockin::LockinSimArgs),
+    /// RLG in a thermal chamber (writes a run file).
+    Chamber(crate::thermal::chamber::ChamberArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -91,6 +93,7 @@ pub struct FogSummary {
 pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
     match cmd {
         SimulateCmd::Lockin(a) => crate::lockin::simulate(&a),
+        SimulateCmd::Chamber(a) => crate::thermal::chamber::simulate(&a),
         SimulateCmd::Fog(a) => {
             let s = simulate_fog(&a)?;
             if a.json {

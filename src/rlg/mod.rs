@@ -5,10 +5,12 @@
 //! [`counter`] (angle increment, rate) -> [`thermal`] (B_TC from the three
 //! temperatures, with coefficients from [`coeffs`]) -> compensated rate.
 
+pub mod channel;
 pub mod coeffs;
 pub mod counter;
 pub mod thermal;
 
+pub use channel::{compensate_rate_ndps, RlgChannel, RlgConfig, RlgWords};
 pub use coeffs::{CoeffError, ThermalCoeffs};
 pub use counter::PulseCounter;
 pub use thermal::{Temperatures, ThermalComp};

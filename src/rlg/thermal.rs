@@ -180,6 +180,27 @@ impl ThermalComp {
         b
     }
 
+    /// Operating time already elapsed at start (a restart, or a record that
+    /// does not begin at power-on): presets F(tau) = 1 - exp(-t/tau_warm).
+    pub fn preset_operating_time(&mut self, c: &ThermalCoeffs, t_s: f64) {
+        let tau = if c.check().is_ok() {
+            c.tau_warm_s
+        } else {
+            ThermalCoeffs::SAFE.tau_warm_s
+        };
+        let f = 1.0 - (-t_s.max(0.0) / tau).exp();
+        self.warm_q30 = (f * (1u64 << 30) as f64).round() as i64;
+    }
+
+    /// Sensor values in use (last good), Q8 degC: mono A, mono B, case.
+    pub fn in_use_q8(&self) -> [i32; 3] {
+        [
+            self.a.last_good_q8,
+            self.b.last_good_q8,
+            self.case.last_good_q8,
+        ]
+    }
+
     /// Last B_TC, Q16 deg/h.
     pub fn bias_q16(&self) -> i64 {
         self.bias_q16

@@ -6,7 +6,9 @@
 pub mod fog_optics;
 pub mod fog_rig;
 pub mod profile;
+pub mod rlg_rig;
 
 pub use fog_optics::{FogOptics, OpticsParams};
 pub use fog_rig::FogRig;
 pub use profile::{Profile, Segment};
+pub use rlg_rig::{Chamber, ChamberParams, ChamberSample};

@@ -1,0 +1,188 @@
+//! Least-squares fit of the RLG thermal bias model (physics.md 2.3) on a
+//! chamber run, next to the classic one-sensor cubic; drift figures.
+//!
+//! The regressors are those the firmware computes (thermal.rs), in f64 with
+//! the same discrete filters: dT = T_a - T_b clamped to +-32 degC; grad(dT)
+//! from the first-order filtered differentiator (tau 20 s, first slope 0,
+//! slope clamped to +-8 degC/s); T_K; F = 1 - exp(-t/tau_warm). The model is
+//! linear in its coefficients once tau_warm is fixed; tau_warm is searched
+//! (log grid, then golden section) for the least residual.
+
+use gyro_sp::rlg::thermal::GRAD_TAU_S;
+use gyro_sp::rlg::ThermalCoeffs;
+use nalgebra::{DMatrix, DVector};
+
+/// Inputs of a fit, one row per sample.
+pub struct ThermalData {
+    pub t: Vec<f64>,
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub case: Vec<f64>,
+    /// Drift to explain: rate minus reference, deg/h.
+    pub drift_dph: Vec<f64>,
+}
+
+/// dT and its filtered gradient, as the firmware forms them.
+pub fn dt_and_gradient(d: &ThermalData) -> (Vec<f64>, Vec<f64>) {
+    let n = d.t.len();
+    let mut dts: Vec<f64> = Vec::with_capacity(n);
+    let mut grads = Vec::with_capacity(n);
+    let mut grad = 0.0;
+    for k in 0..n {
+        let dtk = (d.a[k] - d.b[k]).clamp(-32.0, 32.0);
+        if k > 0 {
+            let h = d.t[k] - d.t[k - 1];
+            let slope = ((dtk - dts[k - 1]) / h).clamp(-8.0, 8.0);
+            grad += h / (GRAD_TAU_S + h) * (slope - grad);
+        }
+        dts.push(dtk);
+        grads.push(grad);
+    }
+    (dts, grads)
+}
+
+/// Least squares with columns scaled to unit RMS; returns the coefficients
+/// and the residual.
+fn lstsq(cols: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+    let n = y.len();
+    let m = cols.len();
+    let scale: Vec<f64> = cols
+        .iter()
+        .map(|c| {
+            let r = (c.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+            if r > 0.0 {
+                r
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let x = DMatrix::from_fn(n, m, |i, j| cols[j][i] / scale[j]);
+    let yv = DVector::from_column_slice(y);
+    let sol = x.clone().svd(true, true).solve(&yv, 1e-12).ok()?;
+    let res = &yv - &x * &sol;
+    let coef = (0..m).map(|j| sol[j] / scale[j]).collect();
+    Some((coef, res.iter().copied().collect()))
+}
+
+fn sse(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// The improved model's fit: coefficients and residual (deg/h).
+pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
+    let (dts, grads) = dt_and_gradient(d);
+    let dt2: Vec<f64> = dts.iter().map(|v| v * v).collect();
+    let ones = vec![1.0; d.t.len()];
+    let solve = |tau: f64| {
+        let warm: Vec<f64> = d.t.iter().map(|t| 1.0 - (-t / tau).exp()).collect();
+        let cols = [
+            ones.clone(),
+            dts.clone(),
+            grads.clone(),
+            dt2.clone(),
+            d.case.clone(),
+            warm,
+        ];
+        lstsq(&cols, &d.drift_dph)
+    };
+    let cost = |lt: f64| solve(lt.exp()).map_or(f64::INFINITY, |(_, r)| sse(&r));
+    // Log grid 30 s .. 30 000 s, then golden section around the best.
+    let (lo, hi) = (30f64.ln(), 30_000f64.ln());
+    let grid: Vec<f64> = (0..=24).map(|i| lo + (hi - lo) * i as f64 / 24.0).collect();
+    let best = grid
+        .iter()
+        .copied()
+        .min_by(|x, y| cost(*x).total_cmp(&cost(*y)))?;
+    let step = (hi - lo) / 24.0;
+    let (mut a, mut b) = ((best - step).max(lo), (best + step).min(hi));
+    let g = 0.618_033_988_75;
+    for _ in 0..40 {
+        let (c, e) = (b - g * (b - a), a + g * (b - a));
+        if cost(c) < cost(e) {
+            b = e;
+        } else {
+            a = c;
+        }
+    }
+    let tau = (0.5 * (a + b)).exp();
+    let (c, r) = solve(tau)?;
+    Some((
+        ThermalCoeffs {
+            bias0_dph: c[0],
+            k1_dph_per_c: c[1],
+            k2_dph_per_c_per_s: c[2],
+            k3_dph_per_c2: c[3],
+            k4_dph_per_c: c[4],
+            k5_dph: c[5],
+            tau_warm_s: tau,
+        },
+        r,
+    ))
+}
+
+/// Classic model: `B = c0 + K3*T + K2*T^2 + K1*T^3` from one sensor.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct CubicModel {
+    /// c0, K3, K2, K1 (deg/h, per degC, per degC^2, per degC^3).
+    pub c: [f64; 4],
+}
+
+impl CubicModel {
+    pub fn fit(temp: &[f64], drift: &[f64]) -> Option<Self> {
+        let cols: Vec<Vec<f64>> = (0..4)
+            .map(|p| temp.iter().map(|t| t.powi(p)).collect())
+            .collect();
+        let (c, _) = lstsq(&cols, drift)?;
+        Some(Self {
+            c: [c[0], c[1], c[2], c[3]],
+        })
+    }
+
+    pub fn eval(&self, t: f64) -> f64 {
+        self.c[0] + t * (self.c[1] + t * (self.c[2] + t * self.c[3]))
+    }
+}
+
+/// Standard deviation of consecutive `window_s` means (by time), deg/h.
+pub fn std_of_means(t: &[f64], x: &[f64], window_s: f64) -> f64 {
+    let means = window_means(t, x, window_s);
+    let n = means.len() as f64;
+    if means.len() < 2 {
+        return f64::NAN;
+    }
+    let m = means.iter().sum::<f64>() / n;
+    (means.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+fn window_means(t: &[f64], x: &[f64], window_s: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let (mut sum, mut cnt) = (0.0, 0usize);
+    let mut end = t.first().copied().unwrap_or(0.0) + window_s;
+    for (&tk, &xk) in t.iter().zip(x) {
+        while tk >= end {
+            if cnt > 0 {
+                out.push(sum / cnt as f64);
+            }
+            sum = 0.0;
+            cnt = 0;
+            end += window_s;
+        }
+        sum += xk;
+        cnt += 1;
+    }
+    out
+}
+
+/// Noise floor of a run at 100 s, deg/h: the Allan deviation at 10 s scaled
+/// as white noise (tau^-1/2) to 100 s. At 10 s the thermal drift is far below
+/// the noise, so this is the noise the run holds, estimated from the data.
+pub fn noise_floor_100s(t: &[f64], x: &[f64]) -> f64 {
+    let m = window_means(t, x, 10.0);
+    if m.len() < 3 {
+        return f64::NAN;
+    }
+    let avar =
+        m.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / (2.0 * (m.len() - 1) as f64);
+    avar.sqrt() * (10.0f64 / 100.0).sqrt()
+}

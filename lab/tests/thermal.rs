@@ -1,0 +1,139 @@
+//! RLG thermal calibration end to end (physics.md 2.3): simulate two chamber
+//! runs with different profiles and orientations, fit on one, compensate the
+//! other with the firmware's fixed-point code through `gyro-lab`.
+
+use std::process::Command;
+
+fn lab_json(args: &[&str]) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
+        .args(args)
+        .arg("--json")
+        .output()
+        .expect("run gyro-lab");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    serde_json::from_str(text.lines().last().unwrap_or("{}")).expect("json")
+}
+
+fn dir() -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("gyro-lab-thermal-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Acceptance: fitted on a -40..+50 degC cycle with the axis up, validated on
+/// a step profile with the axis horizontal towards east (another Earth-rate
+/// component, another noise seed): the residual drift (std of 100 s means)
+/// is within 1.5x the validation run's noise floor, far below the raw drift
+/// and the classic one-sensor cubic.
+#[test]
+fn fit_on_one_run_validate_on_another() {
+    let d = dir();
+    let p = |n: &str| d.join(n).display().to_string();
+    lab_json(&[
+        "simulate",
+        "chamber",
+        "--profile",
+        "cycle",
+        "--out",
+        &p("fit.csv"),
+    ]);
+    lab_json(&[
+        "simulate",
+        "chamber",
+        "--profile",
+        "steps",
+        "--azimuth-deg",
+        "90",
+        "--elevation-deg",
+        "0",
+        "--seed",
+        "7",
+        "--out",
+        &p("val.csv"),
+    ]);
+    let fit = lab_json(&[
+        "fit",
+        "thermal",
+        "--data",
+        &p("fit.csv"),
+        "--out",
+        &p("c.toml"),
+    ]);
+    let truth = gyro_sp::sim::ChamberParams::default().truth;
+    // The well-determined terms come back close to the simulator's truth.
+    let c = &fit["coefficients"];
+    let near = |k: &str, v: f64, tol: f64| {
+        let got = c[k].as_f64().unwrap();
+        assert!((got - v).abs() <= tol * v.abs(), "{k}: {got} vs {v}");
+    };
+    near("k1_dph_per_c", truth.k1_dph_per_c, 0.1);
+    near("k3_dph_per_c2", truth.k3_dph_per_c2, 0.1);
+    near("k4_dph_per_c", truth.k4_dph_per_c, 0.1);
+    near("tau_warm_s", truth.tau_warm_s, 0.25);
+    let v = lab_json(&[
+        "compensate",
+        "--coeffs",
+        &p("c.toml"),
+        "--data",
+        &p("val.csv"),
+        "--out",
+        &p("val_comp.csv"),
+        "--cubic-from",
+        &p("fit.csv"),
+    ]);
+    let f = |k: &str| v[k].as_f64().unwrap();
+    let (raw, comp, floor, cubic) = (
+        f("raw_std_100s_dph"),
+        f("comp_std_100s_dph"),
+        f("noise_floor_100s_dph"),
+        f("cubic_std_100s_dph"),
+    );
+    eprintln!("raw {raw:.4} cubic {cubic:.4} comp {comp:.4} floor {floor:.4} deg/h");
+    assert!(comp <= 1.5 * floor, "{v}");
+    assert!(raw > 5.0 * floor && cubic > 3.0 * comp, "{v}");
+    assert!(!v["coeffs_refused"].as_bool().unwrap());
+    // The written run holds the new column next to the old ones.
+    let text = std::fs::read_to_string(p("val_comp.csv")).unwrap();
+    assert!(text
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with("bias_true_dph,rate_comp_dps"));
+}
+
+/// A broken coefficient file: one line naming file, line and column; exit 2.
+#[test]
+fn bad_coefficient_file() {
+    let d = dir();
+    let bad = d.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "kind = \"rlg_thermal\"\nversion = 1\n[rlg_thermal]\nbias0_dph = 0.1\nk1_dph_per_c = oops\n",
+    )
+    .unwrap();
+    let run = d.join("run.csv");
+    let rows: String = (0..300).map(|k| format!("{k},0,0,20,20,20\n")).collect();
+    std::fs::write(
+        &run,
+        format!("t_s,ref_rate_dps,rate_dps,t_mono_a_c,t_mono_b_c,t_case_c\n{rows}"),
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
+        .args(["compensate", "--coeffs"])
+        .arg(&bad)
+        .arg("--data")
+        .arg(&run)
+        .arg("--out")
+        .arg(d.join("o.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("{}:5:16", bad.display())), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
