@@ -3,8 +3,8 @@
 //! | offset | type | field |
 //! |---|---|---|
 //! | 0 | u8 x2 | sync 0xA5 0x5A |
-//! | 2 | u8 | version (1) |
-//! | 3 | u8 | payload length after this byte, CRC included (42) |
+//! | 2 | u8 | version (2) |
+//! | 3 | u8 | payload length after this byte, CRC included (60) |
 //! | 4 | u16 | sequence number (wraps) |
 //! | 6 | u16 | fault flags, OR over the frame's steps ([`crate::fog::Faults`]) |
 //! | 8 | u16 | closure steps in this frame |
@@ -14,13 +14,22 @@
 //! | 30 | i32 | FOG residual of the last step, phase LSB |
 //! | 34 | u32 | 2*pi loop gain, DAC codes per turn, Q8 |
 //! | 38 | u32 | detector DC, kept-sample sum of one half period, ADC LSB |
-//! | 42 | u16 | CRC-16/CCITT-FALSE over bytes 2..42 |
+//! | 42 | i32 | RLG angle increment, counts (1/K deg, K = counts per degree) |
+//! | 46 | i32 | RLG compensated rate over the frame, micro-deg/s |
+//! | 50 | i32 | RLG thermal bias B_TC in use, Q16 deg/h |
+//! | 54 | i16 x3 | RLG temperatures in use: monoblock A, monoblock B, case; Q8 degC |
+//! | 60 | u8 | RLG flags ([`crate::rlg::thermal::flags`]: sensor A, B, case bad; coefficients refused) |
+//! | 61 | u8 | reserved (0) |
+//! | 62 | u16 | CRC-16/CCITT-FALSE over bytes 2..62 |
+//!
+//! Version 1 (44 bytes) was the FOG part alone.
 
+use crate::rlg::RlgWords;
 use crc::{Crc, CRC_16_IBM_3740};
 
-pub const FRAME_LEN: usize = 44;
+pub const FRAME_LEN: usize = 64;
 pub const SYNC: [u8; 2] = [0xA5, 0x5A];
-pub const VERSION: u8 = 1;
+pub const VERSION: u8 = 2;
 const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -34,6 +43,7 @@ pub struct Frame {
     pub fog_residual: i32,
     pub codes_per_turn_q8: u32,
     pub dc: u32,
+    pub rlg: RlgWords,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +72,14 @@ impl Frame {
         w.put(&self.fog_residual.to_le_bytes());
         w.put(&self.codes_per_turn_q8.to_le_bytes());
         w.put(&self.dc.to_le_bytes());
+        let g = &self.rlg;
+        w.put(&g.delta_counts.to_le_bytes());
+        w.put(&g.rate_comp_udps.to_le_bytes());
+        w.put(&g.bias_q16_dph.to_le_bytes());
+        w.put(&g.t_mono_a_q8.to_le_bytes());
+        w.put(&g.t_mono_b_q8.to_le_bytes());
+        w.put(&g.t_case_q8.to_le_bytes());
+        w.put(&[g.flags, 0]);
         let crc = CRC16.checksum(b.get(2..FRAME_LEN - 2).unwrap_or(&[]));
         if let Some(t) = b.get_mut(FRAME_LEN - 2..) {
             t.copy_from_slice(&crc.to_le_bytes());
@@ -83,8 +101,8 @@ impl Frame {
         if b[3] as usize != FRAME_LEN - 4 {
             return Err(FrameError::Length);
         }
-        let crc = u16::from_le_bytes([b[42], b[43]]);
-        if CRC16.checksum(&b[2..42]) != crc {
+        let crc = u16::from_le_bytes([b[FRAME_LEN - 2], b[FRAME_LEN - 1]]);
+        if CRC16.checksum(&b[2..FRAME_LEN - 2]) != crc {
             return Err(FrameError::Crc);
         }
         let mut r = Reader { buf: b, pos: 4 };
@@ -98,6 +116,15 @@ impl Frame {
             fog_residual: i32::from_le_bytes(r.take()),
             codes_per_turn_q8: u32::from_le_bytes(r.take()),
             dc: u32::from_le_bytes(r.take()),
+            rlg: RlgWords {
+                delta_counts: i32::from_le_bytes(r.take()),
+                rate_comp_udps: i32::from_le_bytes(r.take()),
+                bias_q16_dph: i32::from_le_bytes(r.take()),
+                t_mono_a_q8: i16::from_le_bytes(r.take()),
+                t_mono_b_q8: i16::from_le_bytes(r.take()),
+                t_case_q8: i16::from_le_bytes(r.take()),
+                flags: r.take::<1>()[0],
+            },
         })
     }
 }
@@ -174,6 +201,15 @@ impl FrameBuilder {
         }
     }
 
+    /// Puts the RLG words of this frame in (counts add up, the rest is latest).
+    pub fn set_rlg(&mut self, w: RlgWords) {
+        let d = self.acc.rlg.delta_counts;
+        self.acc.rlg = RlgWords {
+            delta_counts: d.wrapping_add(w.delta_counts),
+            ..w
+        };
+    }
+
     /// Takes back a frame that could not be queued: its steps go into the next
     /// frame (flagged), which reuses its sequence number, so no angle is lost.
     pub fn restore(&mut self, f: Frame) {
@@ -182,6 +218,8 @@ impl FrameBuilder {
         a.faults |= f.faults | crate::fog::Faults::QUEUE_FULL;
         a.fog_angle = a.fog_angle.wrapping_add(f.fog_angle);
         a.fog_angle_raw = a.fog_angle_raw.wrapping_add(f.fog_angle_raw);
+        a.rlg.delta_counts = a.rlg.delta_counts.wrapping_add(f.rlg.delta_counts);
+        a.rlg.flags |= f.rlg.flags;
         self.next_seq = f.seq;
     }
 }

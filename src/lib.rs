@@ -10,6 +10,7 @@
 //! - Modulator DAC codes: `u16`.
 #![no_std]
 
+pub mod drivers;
 pub mod fog;
 pub mod frame;
 pub mod rlg;

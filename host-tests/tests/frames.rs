@@ -2,6 +2,7 @@
 
 use gyro_sp::fog::{ClosureOutput, Faults};
 use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
+use gyro_sp::rlg::RlgWords;
 use proptest::prelude::*;
 
 fn out(step: i64) -> ClosureOutput {
@@ -24,11 +25,23 @@ fn round_trip_and_crc() {
         fog_residual: -5,
         codes_per_turn_q8: 12_582_912,
         dc: 25_000,
+        rlg: RlgWords {
+            delta_counts: -70_000,
+            rate_comp_udps: 123_456_789,
+            bias_q16_dph: -6554,
+            t_mono_a_q8: -40 * 256,
+            t_mono_b_q8: 85 * 256 + 3,
+            t_case_q8: 20 * 256,
+            flags: 0b1010,
+        },
     };
     let b = f.encode();
     assert_eq!(Frame::decode(&b), Ok(f));
     let mut bad = b;
     bad[20] ^= 1;
+    assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
+    let mut bad = b;
+    bad[57] ^= 0x80;
     assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
     assert_eq!(Frame::decode(&b[..FRAME_LEN - 1]), Err(FrameError::Length));
 }
