@@ -3,6 +3,13 @@
 //! 12.5 kHz runs one closure step per interrupt. Under `-icount shift=0` one
 //! instruction is 1 ns of virtual time, so the run is deterministic and SysTick
 //! (core clock) measures the closure's instruction count.
+//!
+//! The RLG channel runs at every frame boundary (500 Hz): a simulated chamber
+//! (`sim::Chamber`, the same model as `gyro-lab simulate chamber`) turns the
+//! profile's rate into encoder counts, and three simulated TMP117s answer on
+//! a simulated I2C bus through the real driver. The case sensor stops
+//! answering for a while to show the fault path. Coefficients come from the
+//! build-time record (build.rs, `RLG_COEFFS`).
 
 use super::{stack, uart, FrameQueue, STEPS_PER_FRAME};
 use core::cell::RefCell;
@@ -11,9 +18,13 @@ use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::exception;
 use defmt_semihosting as _;
+use gyro_sp::drivers::tmp117::Tmp117;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
-use gyro_sp::sim::{profile::qemu_demo, FogRig, OpticsParams};
+use gyro_sp::rlg::coeffs::RECORD_LEN;
+use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
+use gyro_sp::rlg::{RlgChannel, RlgConfig};
+use gyro_sp::sim::{profile::qemu_demo, Chamber, ChamberParams, FogRig, OpticsParams};
 use heapless::spsc::Producer;
 
 /// SysTick clock of the emulated STM32F405 (QEMU's SYSCLK).
@@ -22,6 +33,57 @@ const CLOSURE_HZ: u32 = 12_500;
 const RELOAD: u32 = CORE_HZ / CLOSURE_HZ - 1;
 /// Optical power loss injected during these steps (the final rest segment).
 const POWER_LOSS: core::ops::Range<u32> = 28_500..28_750;
+/// RLG update every frame (25 closure steps, 500 Hz); sensor reads every 50
+/// updates (10 Hz).
+const RLG_HZ: u32 = CLOSURE_HZ / STEPS_PER_FRAME as u32;
+const SENSOR_EVERY: u32 = 50;
+/// The case sensor NACKs during these RLG updates (1.0 .. 1.3 s).
+const CASE_NACK: core::ops::Range<u32> = 500..650;
+
+/// The coefficient record, built from the coefficient file by build.rs.
+static RLG_RECORD: [u8; RECORD_LEN] = *include_bytes!(concat!(env!("OUT_DIR"), "/rlg_coeffs.bin"));
+
+/// Simulated TMP117s on one I2C bus: they answer temperature reads with the
+/// chamber's readings; one address can be made to NACK.
+struct SimI2c {
+    temps_c: [f64; 3],
+    nack: Option<u8>,
+}
+
+impl embedded_hal::i2c::ErrorType for SimI2c {
+    type Error = embedded_hal::i2c::ErrorKind;
+}
+
+impl embedded_hal::i2c::I2c for SimI2c {
+    fn transaction(
+        &mut self,
+        address: u8,
+        operations: &mut [embedded_hal::i2c::Operation<'_>],
+    ) -> Result<(), Self::Error> {
+        let i = match address {
+            0x48..=0x4A if self.nack != Some(address) => (address - 0x48) as usize,
+            _ => return Err(gyro_sp::drivers::tmp117::NACK_ADDRESS),
+        };
+        let reg = ((self.temps_c[i] * 128.0) as i16).to_be_bytes();
+        for op in operations {
+            if let embedded_hal::i2c::Operation::Read(buf) = op {
+                for (b, r) in buf.iter_mut().zip(reg) {
+                    *b = r;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+struct Rlg {
+    cfg: RlgConfig,
+    ch: RlgChannel,
+    chamber: Chamber,
+    bus: SimI2c,
+    sensors: [Tmp117; 3],
+    updates: u32,
+}
 
 struct Bench {
     ticks_sum: u64,
@@ -31,6 +93,8 @@ struct Bench {
 
 struct Ctx {
     rig: FogRig<f32>,
+    rlg: Rlg,
+    rlg_bench: Bench,
     frames: FrameBuilder,
     tx: Producer<'static, Frame, 8>,
     counter: u32,
@@ -64,9 +128,31 @@ pub fn run() -> ! {
         fail()
     };
     let (tx, mut rx) = queue.split();
+    let thermal = ThermalConfig::from_record(&RLG_RECORD, SENSOR_EVERY as f64 / RLG_HZ as f64);
+    if thermal.coeffs_default {
+        defmt::warn!("RLG coefficient record refused: running without thermal compensation");
+    }
+    let chamber_p = ChamberParams::default();
+    let rlg = Rlg {
+        cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ),
+        ch: RlgChannel::default(),
+        chamber: Chamber::new(chamber_p, 20.0),
+        bus: SimI2c {
+            temps_c: [20.0; 3],
+            nack: None,
+        },
+        sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
+        updates: 0,
+    };
     cortex_m::interrupt::free(|cs| {
         CTX.borrow(cs).replace(Some(Ctx {
             rig: FogRig::new(cfg, optics, profile),
+            rlg,
+            rlg_bench: Bench {
+                ticks_sum: 0,
+                ticks_max: 0,
+                n: 0,
+            },
             frames: FrameBuilder::new(STEPS_PER_FRAME, cfg.n_half),
             tx,
             counter: 0,
@@ -104,10 +190,16 @@ pub fn run() -> ! {
         cortex_m::asm::wfi();
     }
     syst.disable_interrupt();
-    let (sum, max, n) = cortex_m::interrupt::free(|cs| {
-        CTX.borrow(cs).borrow().as_ref().map_or((0, 0, 0), |c| {
-            (c.bench.ticks_sum, c.bench.ticks_max, c.bench.n)
-        })
+    let ((sum, max, n), (rsum, rmax, rn)) = cortex_m::interrupt::free(|cs| {
+        CTX.borrow(cs)
+            .borrow()
+            .as_ref()
+            .map_or(((0, 0, 0), (0, 0, 0)), |c| {
+                (
+                    (c.bench.ticks_sum, c.bench.ticks_max, c.bench.n),
+                    (c.rlg_bench.ticks_sum, c.rlg_bench.ticks_max, c.rlg_bench.n),
+                )
+            })
     });
     let mean_instr = sum as f32 / n.max(1) as f32 * ipt;
     defmt::info!("frames sent: {}", sent);
@@ -116,6 +208,11 @@ pub fn run() -> ! {
         mean_instr as u32,
         (max as f32 * ipt) as u32,
         stack::high_water()
+    );
+    defmt::info!(
+        "bench: rlg_update_instructions={} rlg_max={}",
+        (rsum as f32 / rn.max(1) as f32 * ipt) as u32,
+        (rmax as f32 * ipt) as u32
     );
     cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_SUCCESS);
     loop {
@@ -160,11 +257,52 @@ fn closure(ctx: &mut Ctx) {
     if out.faults.has(Faults::OPTICAL_POWER_LOW) && ctx.counter == POWER_LOSS.start + 1 {
         defmt::warn!("optical power low at step {}", ctx.counter);
     }
+    if ctx.counter.is_multiple_of(STEPS_PER_FRAME as u32) {
+        rlg_update(ctx);
+    }
     if let Some(f) = ctx.frames.push(&out, ctx.counter) {
         if let Err(f) = ctx.tx.enqueue(f) {
             ctx.frames.restore(f);
         }
     }
+}
+
+/// One RLG update: the chamber advances one update period, the counter is
+/// read; on sensor ticks the three TMP117s are read and the compensation runs
+/// (what the bench times: counter read + compensation, the update interrupt's
+/// work). The frame gets the RLG words.
+fn rlg_update(ctx: &mut Ctx) {
+    let r = &mut ctx.rlg;
+    let dt = 1.0 / RLG_HZ as f64;
+    let t_mid = (r.updates as f64 + 0.5) * dt;
+    let rate_dps = ctx.rig.profile.rate_at(t_mid as f32) as f64 * (180.0 / core::f64::consts::PI);
+    let s = r.chamber.step(dt, 20.0, rate_dps);
+    r.bus.temps_c = [s.t_mono_a_c, s.t_mono_b_c, s.t_case_c];
+    r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
+    let temps = r
+        .updates
+        .is_multiple_of(SENSOR_EVERY)
+        .then(|| Temperatures {
+            mono_a_q8: r.sensors[0].read(&mut r.bus),
+            mono_b_q8: r.sensors[1].read(&mut r.bus),
+            case_q8: r.sensors[2].read(&mut r.bus),
+        });
+    let t0 = SYST::get_current();
+    r.ch.update(&r.cfg, s.counter, temps.as_ref());
+    let t1 = SYST::get_current();
+    if temps.is_some() {
+        let ticks = if t1 <= t0 {
+            t0 - t1
+        } else {
+            t0 + RELOAD + 1 - t1
+        };
+        ctx.rlg_bench.ticks_sum += ticks as u64;
+        ctx.rlg_bench.ticks_max = ctx.rlg_bench.ticks_max.max(ticks);
+        ctx.rlg_bench.n += 1;
+    }
+    r.updates += 1;
+    let (counts, n) = r.ch.take_frame();
+    ctx.frames.set_rlg(r.ch.words(&r.cfg, counts, n));
 }
 
 /// Instructions per SysTick tick, measured on a loop of known length

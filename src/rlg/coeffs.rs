@@ -77,7 +77,7 @@ impl ThermalCoeffs {
         }
     }
 
-    pub fn to_record(&self) -> [u8; RECORD_LEN] {
+    pub fn to_record(self) -> [u8; RECORD_LEN] {
         let mut r = [0u8; RECORD_LEN];
         r[..4].copy_from_slice(MAGIC);
         r[4..6].copy_from_slice(&VERSION.to_le_bytes());

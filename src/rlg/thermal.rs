@@ -97,6 +97,20 @@ impl ThermalConfig {
     }
 }
 
+impl ThermalConfig {
+    /// From a stored record (coeffs.rs): a corrupt, wrong-version or
+    /// out-of-range record gives the SAFE set with `coeffs_default` up.
+    pub fn from_record(record: &[u8], dt_s: f64) -> Self {
+        match ThermalCoeffs::from_record(record) {
+            Ok(c) => Self::new(&c, dt_s),
+            Err(_) => Self {
+                coeffs_default: true,
+                ..Self::new(&ThermalCoeffs::SAFE, dt_s)
+            },
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 struct Sensor {
     last_good_q8: i32,

@@ -3,7 +3,9 @@
 use anyhow::{Context, Result};
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
+use gyro_sp::rlg::thermal::flags as rlg_flags;
 use gyro_sp::sim::profile::qemu_demo;
+use gyro_sp::sim::ChamberParams;
 use std::io::Write;
 use std::path::Path;
 
@@ -15,6 +17,9 @@ pub struct Row {
     pub ref_rate: f64,
     pub rate: f64,
     pub rate_raw: f64,
+    /// RLG: compensated rate and counts-only rate, deg/s.
+    pub rlg_rate_dps: f64,
+    pub rlg_rate_raw_dps: f64,
     pub frame: Frame,
     pub segment: usize,
     pub t_in_segment: f64,
@@ -46,6 +51,7 @@ pub fn analyse(path: &Path) -> Result<Report> {
         .collect();
     let n_half = cfg.n_half as u64;
     let tau = cfg.params.tau_s;
+    let counts_per_deg = ChamberParams::default().counts_per_deg;
     let (mut i, mut bad) = (0usize, 0usize);
     let mut rows = Vec::new();
     let (mut seq_gaps, mut step_gaps) = (0, 0);
@@ -78,7 +84,10 @@ pub fn analyse(path: &Path) -> Result<Report> {
                 let lsb = cfg.rad_s_per_step_lsb();
                 let t_mid = (start + end) as f64 / 2.0 * n_half as f64 * tau;
                 let segment = seg_starts.iter().rposition(|&s| t_mid >= s).unwrap_or(0);
+                let frame_s = halves * tau;
                 rows.push(Row {
+                    rlg_rate_dps: f.rlg.rate_comp_udps as f64 * 1e-6,
+                    rlg_rate_raw_dps: f.rlg.delta_counts as f64 / counts_per_deg / frame_s,
                     t_s: end as f64 * n_half as f64 * tau,
                     ref_rate: truth / halves,
                     rate: f.fog_angle as f64 * lsb / halves,
@@ -103,6 +112,34 @@ pub fn analyse(path: &Path) -> Result<Report> {
         segment_names: names,
         cfg,
     })
+}
+
+/// The RLG channel's run file (interfaces.md run-file columns).
+pub fn write_rlg_run_file(r: &Report, path: &Path) -> Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(
+        w,
+        "# gyro-fw under qemu-system-arm, RLG channel (simulated chamber at 20 degC); one row per frame"
+    )?;
+    writeln!(w, "t_s,ref_rate_dps,rate_dps,rate_raw_dps,delta_counts,t_mono_a_c,t_mono_b_c,t_case_c,bias_dph,rlg_flags")?;
+    for row in &r.rows {
+        let g = &row.frame.rlg;
+        writeln!(
+            w,
+            "{:.6},{:.9},{:.6},{:.6},{},{:.4},{:.4},{:.4},{:.5},{}",
+            row.t_s,
+            row.ref_rate / DEG,
+            row.rlg_rate_dps,
+            row.rlg_rate_raw_dps,
+            g.delta_counts,
+            g.t_mono_a_q8 as f64 / 256.0,
+            g.t_mono_b_q8 as f64 / 256.0,
+            g.t_case_q8 as f64 / 256.0,
+            g.bias_q16_dph as f64 / 65_536.0,
+            g.flags
+        )?;
+    }
+    Ok(())
 }
 
 pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
@@ -196,6 +233,56 @@ pub fn print_summary(r: &Report) {
     let eps = 50_000.0 * DEG;
     let pred = r.cfg.predicted_vibration_drift(eps * eps / 2.0) * DPH;
     println!("vibration drift formula (-(1/4) cot(phi0) K_s <eps^2> dt_m dt_p): {pred:.4} deg/h");
+    let g = rlg_stats(r);
+    println!(
+        "RLG: angle {:.4} deg from {} counts, truth {:.4} deg (error {:+.1} counts); B_TC {:.4} deg/h; \
+         temperatures {:.3}/{:.3}/{:.3} degC (mono A/B, case); flags seen {:#04x}",
+        g.angle_deg, g.counts, g.truth_deg, g.error_counts, g.bias_dph, g.temps[0], g.temps[1], g.temps[2], g.flags_seen
+    );
+}
+
+pub struct RlgStats {
+    pub counts: i64,
+    pub angle_deg: f64,
+    pub truth_deg: f64,
+    pub error_counts: f64,
+    pub bias_dph: f64,
+    pub temps: [f64; 3],
+    pub flags_seen: u8,
+    /// Frames with the case-sensor flag, and whether the last frame is clear.
+    pub case_flagged: usize,
+    pub case_cleared: bool,
+}
+
+pub fn rlg_stats(r: &Report) -> RlgStats {
+    let k = ChamberParams::default().counts_per_deg;
+    let counts: i64 = r.rows.iter().map(|x| x.frame.rlg.delta_counts as i64).sum();
+    let mut truth = 0.0;
+    let mut t_prev = 0.0;
+    for x in &r.rows {
+        truth += x.ref_rate / DEG * (x.t_s - t_prev);
+        t_prev = x.t_s;
+    }
+    let last = r.rows.last().map(|x| x.frame.rlg).unwrap_or_default();
+    RlgStats {
+        counts,
+        angle_deg: counts as f64 / k,
+        truth_deg: truth,
+        error_counts: counts as f64 - truth * k,
+        bias_dph: last.bias_q16_dph as f64 / 65_536.0,
+        temps: [
+            last.t_mono_a_q8 as f64 / 256.0,
+            last.t_mono_b_q8 as f64 / 256.0,
+            last.t_case_q8 as f64 / 256.0,
+        ],
+        flags_seen: r.rows.iter().fold(0, |a, x| a | x.frame.rlg.flags),
+        case_flagged: r
+            .rows
+            .iter()
+            .filter(|x| x.frame.rlg.flags & rlg_flags::SENSOR_CASE != 0)
+            .count(),
+        case_cleared: last.flags & rlg_flags::SENSOR_CASE == 0,
+    }
 }
 
 /// The firmware tests under QEMU: (name, passed, detail).
@@ -254,6 +341,31 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
         "power_loss_flag_rises_and_clears",
         !fault_rows.is_empty() && cleared,
         format!("{} flagged frames", fault_rows.len()),
+    ));
+    // RLG: no count lost (the angle from the frames' counts matches the
+    // profile's angle within the counter's quantization and the bias), the
+    // case sensor's NACK window flags and clears, the coefficients loaded.
+    let g = rlg_stats(r);
+    v.push((
+        "rlg_no_lost_counts",
+        g.error_counts.abs() <= 3.0 && g.counts != 0,
+        format!(
+            "{} counts, {:+.2} counts from the truth",
+            g.counts, g.error_counts
+        ),
+    ));
+    v.push((
+        "rlg_sensor_fault_flag_rises_and_clears",
+        g.case_flagged > 0 && g.case_cleared,
+        format!("{} frames with the case sensor flagged", g.case_flagged),
+    ));
+    v.push((
+        "rlg_coefficients_loaded",
+        g.flags_seen & rlg_flags::COEFFS_DEFAULT == 0 && g.bias_dph != 0.0,
+        format!(
+            "B_TC {:.4} deg/h, flags seen {:#04x}",
+            g.bias_dph, g.flags_seen
+        ),
     ));
     v
 }

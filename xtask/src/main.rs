@@ -138,6 +138,9 @@ fn qemu_cmd() -> Result<()> {
     frames::write_run_file(&report, &csv)?;
     frames::print_summary(&report);
     println!("run file: {}", csv.display());
+    let rlg_csv = root().join("runs").join("qemu-rlg.csv");
+    frames::write_rlg_run_file(&report, &rlg_csv)?;
+    println!("RLG run file: {}", rlg_csv.display());
     Ok(())
 }
 
@@ -201,6 +204,15 @@ fn bench_cmd() -> Result<()> {
     };
     let instr = grab("fog_closure_instructions").context("no bench line in the firmware log")?;
     let stack = grab("stack_bytes").context("no stack figure in the firmware log")?;
+    let rlg_instr = qrun
+        .log
+        .lines()
+        .find_map(|l| {
+            l.split_whitespace()
+                .find_map(|w| w.strip_prefix("rlg_update_instructions="))
+                .and_then(|v| v.trim().parse::<u64>().ok())
+        })
+        .context("no RLG bench line in the firmware log")?;
     let (flash, ram) = frames::elf_sizes(&qrun.elf)?;
     // Real-time factor of the host simulator (release build, default options).
     run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
@@ -216,6 +228,7 @@ fn bench_cmd() -> Result<()> {
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
         "fog_closure_instructions_max": grab("max"),
+        "rlg_update_instructions": rlg_instr,
         "sim_fog_realtime_factor": (rtf * 10.0).round() / 10.0,
         "flash_bytes": flash,
         "ram_bytes": ram,
