@@ -163,3 +163,43 @@ fn sensor_faults_flag_and_hold() {
     comp.update(&cfg, &good(300));
     assert_eq!(comp.flags(), 0);
 }
+
+/// The frame words: the compensated rate is counts/(K*T) - B_TC (formula, in
+/// f64) to the micro-deg/s word's resolution, for rates up to +-500 deg/s.
+#[test]
+fn channel_words_match_formula() {
+    use gyro_sp::rlg::{RlgChannel, RlgConfig};
+    let coeffs = ThermalCoeffs {
+        bias0_dph: 0.5,
+        k4_dph_per_c: 0.01,
+        ..ThermalCoeffs::SAFE
+    };
+    let k = 8000.0;
+    let cfg = RlgConfig::new(ThermalConfig::new(&coeffs, 0.1), k, 500);
+    for &rate_dps in &[0.0, 1e-3, 15.0 / 3600.0, -123.456, 499.9] {
+        let mut ch = RlgChannel::default();
+        let temps = Temperatures {
+            mono_a_q8: Some(20 * 256),
+            mono_b_q8: Some(20 * 256),
+            case_q8: Some(40 * 256),
+        };
+        let mut raw = 0u16;
+        let mut angle = 0.0f64;
+        ch.update(&cfg, raw, Some(&temps));
+        ch.take_frame();
+        for _ in 0..100 {
+            angle += rate_dps / 500.0 * k;
+            raw = (angle.floor() as i64) as u16;
+            ch.update(&cfg, raw, None);
+        }
+        let (counts, n) = ch.take_frame();
+        let w = ch.words(&cfg, counts, n);
+        let expect = counts as f64 / k / (n as f64 / 500.0) - (0.5 + 0.01 * 40.0) / 3600.0;
+        assert!(
+            (w.rate_comp_udps as f64 * 1e-6 - expect).abs() <= 1.5e-6,
+            "{rate_dps}: {} vs {expect}",
+            w.rate_comp_udps as f64 * 1e-6
+        );
+        assert_eq!(w.t_case_q8, 40 * 256);
+    }
+}
