@@ -63,7 +63,8 @@ fn noise_1pct_within_half_percent() {
 }
 
 /// Acceptance, 8-bit records of 2 500 points: within 1 % up to
-/// Omega_I/Omega_L = 10, and within 3 sigma of the fit's bound beyond.
+/// Omega_I/Omega_L = 50, and within 3 sigma of the fit's bound everywhere
+/// (at 100 the bound is 1.5 %).
 #[test]
 fn eight_bit_within_one_percent() {
     let rows = table(Record::EightBit, 6);
@@ -73,7 +74,7 @@ fn eight_bit_within_one_percent() {
             row.exact_max_pct <= 3.0 * row.exact_std_pct.max(0.05),
             "{row:?}"
         );
-        if row.ratio <= 10.0 {
+        if row.ratio <= 50.0 {
             assert!(row.exact_max_pct <= 1.0, "{row:?}");
         }
     }
