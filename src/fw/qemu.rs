@@ -91,6 +91,21 @@ struct Bench {
     n: u32,
 }
 
+impl Bench {
+    /// One timed section between two SysTick reads.
+    fn record(&mut self, t0: u32, t1: u32) {
+        // SysTick counts down and reloads at 0: a reload in between adds RELOAD + 1.
+        let ticks = if t1 <= t0 {
+            t0 - t1
+        } else {
+            t0 + RELOAD + 1 - t1
+        };
+        self.ticks_sum += ticks as u64;
+        self.ticks_max = self.ticks_max.max(ticks);
+        self.n += 1;
+    }
+}
+
 struct Ctx {
     rig: FogRig<f32>,
     rlg: Rlg,
@@ -243,15 +258,7 @@ fn closure(ctx: &mut Ctx) {
     let t0 = SYST::get_current();
     let out = ctx.rig.process_core();
     let t1 = SYST::get_current();
-    // SysTick counts down and reloads at 0: a reload in between adds RELOAD + 1.
-    let ticks = if t1 <= t0 {
-        t0 - t1
-    } else {
-        t0 + RELOAD + 1 - t1
-    };
-    ctx.bench.ticks_sum += ticks as u64;
-    ctx.bench.ticks_max = ctx.bench.ticks_max.max(ticks);
-    ctx.bench.n += 1;
+    ctx.bench.record(t0, t1);
     ctx.rig.finish_step(out, truth);
     ctx.counter += 1;
     if out.faults.has(Faults::OPTICAL_POWER_LOW) && ctx.counter == POWER_LOSS.start + 1 {
@@ -291,14 +298,7 @@ fn rlg_update(ctx: &mut Ctx) {
     r.ch.update(&r.cfg, s.counter, temps.as_ref());
     let t1 = SYST::get_current();
     if temps.is_some() {
-        let ticks = if t1 <= t0 {
-            t0 - t1
-        } else {
-            t0 + RELOAD + 1 - t1
-        };
-        ctx.rlg_bench.ticks_sum += ticks as u64;
-        ctx.rlg_bench.ticks_max = ctx.rlg_bench.ticks_max.max(ticks);
-        ctx.rlg_bench.n += 1;
+        ctx.rlg_bench.record(t0, t1);
     }
     r.updates += 1;
     let (counts, n) = r.ch.take_frame();

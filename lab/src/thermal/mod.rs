@@ -51,6 +51,18 @@ pub fn to_coeffs(c: &RlgThermal) -> ThermalCoeffs {
     }
 }
 
+pub fn from_coeffs(c: &ThermalCoeffs) -> RlgThermal {
+    RlgThermal {
+        bias0_dph: c.bias0_dph,
+        k1_dph_per_c: c.k1_dph_per_c,
+        k2_dph_per_c_per_s: c.k2_dph_per_c_per_s,
+        k3_dph_per_c2: c.k3_dph_per_c2,
+        k4_dph_per_c: c.k4_dph_per_c,
+        k5_dph: c.k5_dph,
+        tau_warm_s: c.tau_warm_s,
+    }
+}
+
 /// B_TC per row by the firmware's own fixed-point compensation (thermal.rs),
 /// one sensor update per row (the period from `t_s`), F(tau) preset to the
 /// operating time before the first row. Returns B_TC, Q16 deg/h, and flags.
@@ -128,15 +140,7 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
         .zip(&d.a)
         .map(|(y, t)| y - cubic.eval(*t))
         .collect();
-    let coefficients = RlgThermal {
-        bias0_dph: c.bias0_dph,
-        k1_dph_per_c: c.k1_dph_per_c,
-        k2_dph_per_c_per_s: c.k2_dph_per_c_per_s,
-        k3_dph_per_c2: c.k3_dph_per_c2,
-        k4_dph_per_c: c.k4_dph_per_c,
-        k5_dph: c.k5_dph,
-        tau_warm_s: c.tau_warm_s,
-    };
+    let coefficients = from_coeffs(&c);
     let s = FitSummary {
         coefficients,
         raw_std_100s_dph: std_of_means(&d.t, &d.drift_dph, 100.0),
