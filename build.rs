@@ -29,15 +29,6 @@ fn main() {
     let c = f
         .rlg_thermal
         .unwrap_or_else(|| panic!("{}: no [rlg_thermal]", path.display()));
-    let record = coeffs::ThermalCoeffs {
-        bias0_dph: c.bias0_dph,
-        k1_dph_per_c: c.k1_dph_per_c,
-        k2_dph_per_c_per_s: c.k2_dph_per_c_per_s,
-        k3_dph_per_c2: c.k3_dph_per_c2,
-        k4_dph_per_c: c.k4_dph_per_c,
-        k5_dph: c.k5_dph,
-        tau_warm_s: c.tau_warm_s,
-    }
-    .to_record();
+    let record = coeffs::ThermalCoeffs::from_values(c.values()).to_record();
     fs::write(out.join("rlg_coeffs.bin"), record).unwrap();
 }

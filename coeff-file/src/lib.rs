@@ -32,6 +32,34 @@ pub struct RlgThermal {
     pub tau_warm_s: f64,
 }
 
+impl RlgThermal {
+    /// The values in the firmware record's order: bias0, k1..k5, tau_warm.
+    pub fn values(&self) -> [f64; 7] {
+        [
+            self.bias0_dph,
+            self.k1_dph_per_c,
+            self.k2_dph_per_c_per_s,
+            self.k3_dph_per_c2,
+            self.k4_dph_per_c,
+            self.k5_dph,
+            self.tau_warm_s,
+        ]
+    }
+
+    /// From values in record order.
+    pub fn from_values(v: [f64; 7]) -> Self {
+        Self {
+            bias0_dph: v[0],
+            k1_dph_per_c: v[1],
+            k2_dph_per_c_per_s: v[2],
+            k3_dph_per_c2: v[3],
+            k4_dph_per_c: v[4],
+            k5_dph: v[5],
+            tau_warm_s: v[6],
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CoeffFile {
     pub kind: String,
@@ -67,16 +95,7 @@ pub fn read(path: &Path) -> Result<CoeffFile, String> {
     }
     match (f.kind.as_str(), &f.rlg_thermal) {
         ("rlg_thermal", Some(c)) => {
-            let v = [
-                c.bias0_dph,
-                c.k1_dph_per_c,
-                c.k2_dph_per_c_per_s,
-                c.k3_dph_per_c2,
-                c.k4_dph_per_c,
-                c.k5_dph,
-                c.tau_warm_s,
-            ];
-            if v.iter().any(|x| !x.is_finite()) {
+            if c.values().iter().any(|x| !x.is_finite()) {
                 return Err(format!(
                     "{name}: [rlg_thermal] holds a value that is not finite"
                 ));

@@ -52,7 +52,8 @@ impl ThermalCoeffs {
         tau_warm_s: 600.0,
     };
 
-    fn values(&self) -> [f64; 7] {
+    /// The values in record order: bias0, k1..k5, tau_warm.
+    pub fn values(&self) -> [f64; 7] {
         [
             self.bias0_dph,
             self.k1_dph_per_c,
@@ -74,6 +75,19 @@ impl ThermalCoeffs {
             Ok(())
         } else {
             Err(CoeffError::Range)
+        }
+    }
+
+    /// From values in record order (see [`Self::values`]); not checked.
+    pub fn from_values(v: [f64; 7]) -> Self {
+        Self {
+            bias0_dph: v[0],
+            k1_dph_per_c: v[1],
+            k2_dph_per_c_per_s: v[2],
+            k3_dph_per_c2: v[3],
+            k4_dph_per_c: v[4],
+            k5_dph: v[5],
+            tau_warm_s: v[6],
         }
     }
 
@@ -106,15 +120,7 @@ impl ThermalCoeffs {
             b.copy_from_slice(chunk);
             *x = f64::from_le_bytes(b);
         }
-        let c = Self {
-            bias0_dph: v[0],
-            k1_dph_per_c: v[1],
-            k2_dph_per_c_per_s: v[2],
-            k3_dph_per_c2: v[3],
-            k4_dph_per_c: v[4],
-            k5_dph: v[5],
-            tau_warm_s: v[6],
-        };
+        let c = Self::from_values(v);
         c.check()?;
         Ok(c)
     }

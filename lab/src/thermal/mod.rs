@@ -40,27 +40,11 @@ pub fn read_run(path: &Path) -> Result<(Table, ThermalData, Vec<f64>), LabError>
 }
 
 pub fn to_coeffs(c: &RlgThermal) -> ThermalCoeffs {
-    ThermalCoeffs {
-        bias0_dph: c.bias0_dph,
-        k1_dph_per_c: c.k1_dph_per_c,
-        k2_dph_per_c_per_s: c.k2_dph_per_c_per_s,
-        k3_dph_per_c2: c.k3_dph_per_c2,
-        k4_dph_per_c: c.k4_dph_per_c,
-        k5_dph: c.k5_dph,
-        tau_warm_s: c.tau_warm_s,
-    }
+    ThermalCoeffs::from_values(c.values())
 }
 
 pub fn from_coeffs(c: &ThermalCoeffs) -> RlgThermal {
-    RlgThermal {
-        bias0_dph: c.bias0_dph,
-        k1_dph_per_c: c.k1_dph_per_c,
-        k2_dph_per_c_per_s: c.k2_dph_per_c_per_s,
-        k3_dph_per_c2: c.k3_dph_per_c2,
-        k4_dph_per_c: c.k4_dph_per_c,
-        k5_dph: c.k5_dph,
-        tau_warm_s: c.tau_warm_s,
-    }
+    RlgThermal::from_values(c.values())
 }
 
 /// B_TC per row by the firmware's own fixed-point compensation (thermal.rs),
