@@ -27,6 +27,22 @@ fn reference(adc: &[u16], n: usize, skip: usize, halves: usize, c: &Carries) -> 
     d
 }
 
+/// The multiply-based count of short carry masks against the plain count,
+/// every 8-bit mask; longer masks take the general count.
+#[test]
+fn carry_count_matches_count_ones() {
+    use gyro_sp::fog::gain_loop::carry_count;
+    for m in 0..256u32 {
+        assert_eq!(carry_count(m, 8), m.count_ones(), "mask {m:#x}");
+        assert_eq!(
+            carry_count(m | 0xFF00, 8),
+            m.count_ones(),
+            "bits above 8 ignored"
+        );
+    }
+    assert_eq!(carry_count(0xFFFF_0F0F, 16), 24);
+}
+
 proptest! {
     /// Every sample layout (the unrolled ones and the runtime fallback) gives
     /// the reference sums.

@@ -37,11 +37,11 @@ pub struct FogLoop {
     step: i64,
     /// Digital gain, DAC codes per turn in Q8.
     cpt_q8: u32,
-    /// Low-passed DC of one half period, ADC LSB in Q12; time constant 4096 steps
-    /// (0.33 s). Slow on purpose: a step's DC has a first-order term in the
+    /// Low-passed DC of one half period, ADC LSB in Q12 (below 2^32: a half
+    /// period's kept sum is below 2^20); time constant 4096 steps (0.33 s). Slow on purpose: a step's DC has a first-order term in the
     /// in-step residual slope (proportional to eps), so a fast AGC would modulate
     /// the loop gain at the vibration frequency and rectify a second eps^2 drift.
-    dc_q12: u64,
+    dc_q12: u32,
     /// The DC filter holds a measured value (seeded on the first good step).
     dc_valid: bool,
     modulator: Modulator,
@@ -54,6 +54,20 @@ pub struct FogLoop {
     dither: u32,
 }
 
+/// Largest kept-sample sum of one half period, ADC LSB (15 kept samples of
+/// 16-bit codes), so the Q12 DC filter fits a u32.
+const MAX_HALF_SUM: u32 = (1 << 20) - 1;
+
+/// `x` saturated to the i32 range (compare the high word with the low
+/// word's sign: a few instructions, not a 64-bit clamp).
+#[inline(always)]
+pub(crate) fn saturate_i32(x: i64) -> i32 {
+    match i32::try_from(x) {
+        Ok(v) => v,
+        Err(_) => ((x >> 63) as i32) ^ i32::MAX,
+    }
+}
+
 /// Feedback-step clamp: +-2^40 LSB is +-256 turns, about +-1200 rad/s at K_s = 1.35 s.
 const STEP_LIMIT: i64 = 1 << 40;
 
@@ -62,7 +76,7 @@ impl FogLoop {
         Self {
             step: 0,
             cpt_q8: cfg.cpt_nominal_q8,
-            dc_q12: (cfg.h0_nominal as u64) << 12,
+            dc_q12: cfg.h0_nominal.min(MAX_HALF_SUM) << 12,
             dc_valid: false,
             modulator: Modulator::default(),
             carries: Carries::default(),
@@ -108,25 +122,41 @@ impl FogLoop {
         adc_over_range: bool,
         dac: &mut [u16],
     ) -> ClosureOutput {
-        let n_half = cfg.n_half;
-        let (Some(adc), Some(dac)) = (adc.get(..cfg.n_samples), dac.get_mut(..n_half)) else {
+        // The reference instruments' layouts get a copy of the step with the
+        // sizes as constants (divisions become shifts, loops unroll); any
+        // other layout runs the same code with runtime sizes.
+        let layout = (cfg.n_half, cfg.samples_per_half, cfg.skip_samples);
+        match layout {
+            (16, 4, 1) => self.step_with((16, 4, 1), cfg, adc, adc_over_range, dac),
+            (32, 4, 1) => self.step_with((32, 4, 1), cfg, adc, adc_over_range, dac),
+            _ => self.step_with(layout, cfg, adc, adc_over_range, dac),
+        }
+    }
+
+    /// [`Self::process`] for `(n_half, samples_per_half, skip)` = `layout`
+    /// (equal to the config's).
+    #[inline(always)]
+    fn step_with(
+        &mut self,
+        (n_half, samples_per_half, skip): (usize, usize, usize),
+        cfg: &FogConfig,
+        adc: &[u16],
+        adc_over_range: bool,
+        dac: &mut [u16],
+    ) -> ClosureOutput {
+        let n_samples = n_half * samples_per_half;
+        let (Some(adc), Some(dac)) = (adc.get(..n_samples), dac.get_mut(..n_half)) else {
             self.faults.set(Faults::ADC_SATURATION, true);
             return self.output(self.step, 0, 0, 0);
         };
-        let sums = demodulate(
-            adc,
-            cfg.samples_per_half,
-            cfg.skip_samples,
-            n_half,
-            &self.carries,
-        );
+        let sums = demodulate(adc, samples_per_half, skip, n_half, &self.carries);
         // Detector DC of one half period, ADC dark level removed (per-half sum).
         let h_step = (sums.dc / n_half as u32).saturating_sub(cfg.dark_half);
         let power_low = h_step < cfg.h0_min;
         self.faults.set(Faults::OPTICAL_POWER_LOW, power_low);
         self.faults.set(Faults::ADC_SATURATION, adc_over_range);
 
-        let mut residual = 0i64;
+        let mut residual = 0i32;
         let mut bias = 0i64;
         // Sagnac phase measured over this step: applied step plus residual.
         let mut measured = self.step;
@@ -140,27 +170,35 @@ impl FogLoop {
             // Slow AGC: normalise by a low-passed DC so the loop gain does not depend
             // on optical power, without correlating the gain with this step's error.
             // Frozen while the ADC clips (the DC is then wrong).
+            let h_step = h_step.min(MAX_HALF_SUM);
             if !self.dc_valid {
-                self.dc_q12 = (h_step as u64) << 12;
+                self.dc_q12 = h_step << 12;
                 self.dc_valid = !adc_over_range;
             } else if !adc_over_range {
-                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step as u64;
+                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step;
             }
-            let h = ((self.dc_q12 >> 12) as u32).max(1);
+            let h = (self.dc_q12 >> 12).max(1);
             let recip_h = u32::MAX / h; // 2^32 / H
                                         // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H.
+                                        // Config bounds k_meas/h0_min so that kn < 2^36 (and this product < 2^60).
             let kn = ((cfg.k_meas_q8 * recip_h as u64) >> 24) as i64;
-            // |sum| < 2^22, kn < 2^31 (H >= h0_min): products below 2^53.
-            residual = (-(sums.first as i64 + sums.second as i64) * kn) >> 16;
-            let slope = ((2 * (sums.first as i64 - sums.second as i64) * kn) >> 24)
-                .clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+            // Kept sums < 2^20 per half, at most 64 halves: |sum|, |diff| < 2^26;
+            // kn < 2^36: both products below 2^63. The residual
+            // saturates at +-half a turn: the error is periodic, so an estimate
+            // beyond that only says "far out" (lock acquisition then takes
+            // several steps, as it would anyway).
+            let sum = sums.first as i64 + sums.second as i64;
+            residual = saturate_i32((-sum * kn) >> 16);
+            // In-step slope, 2^8 phase LSB (the correction saturates it).
+            let slope = saturate_i32(((sums.first as i64 - sums.second as i64) * kn) >> 23);
 
             // Clipped samples still give the error's sign, so the main loop keeps
             // running through over-range (holding it could lock it there); the
             // gain loop and the correction, which need true levels, pause.
-            measured = self.step + residual;
-            self.step =
-                (self.step + ((residual * cfg.loop_gain_q16) >> 16)).clamp(-STEP_LIMIT, STEP_LIMIT);
+            measured = self.step + residual as i64;
+            // |residual| < 2^31, gain < 2^17 (Q16 below 2): one 32x32 product.
+            let correction = (residual as i64 * cfg.loop_gain_q16 as i64) >> 16;
+            self.step = (self.step + correction).clamp(-STEP_LIMIT, STEP_LIMIT);
             if adc_over_range {
                 self.vibration.reset();
             } else {
@@ -168,16 +206,16 @@ impl FogLoop {
                 self.cpt_q8 = gain_loop::update(
                     self.cpt_q8,
                     err,
-                    cfg.gain_loop_q16,
+                    cfg.gain_loop,
                     recip_h,
                     cfg.cpt_min_q8,
                     cfg.cpt_max_q8,
                 );
                 if cfg.vibration_correction {
-                    bias = self.vibration.update(slope, cfg.vib_coeff, cfg.vib_shift);
+                    bias = self.vibration.update(slope, cfg.vib_coeff);
                 }
             }
-            let unlocked = residual.unsigned_abs() > cfg.lock_limit as u64;
+            let unlocked = residual.unsigned_abs() > cfg.lock_limit;
             self.unlocked_steps = if unlocked {
                 self.unlocked_steps.saturating_add(1)
             } else {
@@ -197,11 +235,11 @@ impl FogLoop {
         out
     }
 
-    fn output(&self, measured: i64, residual: i64, bias: i64, dc: u32) -> ClosureOutput {
+    fn output(&self, measured: i64, residual: i32, bias: i64, dc: u32) -> ClosureOutput {
         ClosureOutput {
             step: measured,
             step_corrected: measured - bias,
-            residual: residual.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            residual,
             codes_per_turn_q8: self.cpt_q8,
             dc,
             faults: self.faults,

@@ -94,7 +94,8 @@ pub enum ConfigError {
     LoopGain,
     /// DAC codes per turn leave no headroom for the 2*pi loop in 16 bits.
     DacRange,
-    /// Non-finite or non-positive physical parameter.
+    /// Non-finite or non-positive physical parameter, or a nominal detector
+    /// level too dim for the error scaling's range.
     Physical,
 }
 
@@ -118,18 +119,19 @@ pub struct FogConfig {
     /// in Q8 (phase LSB * 2^8 per unit of sum(sign*h)/H0).
     pub k_meas_q8: u64,
     /// Main-loop gain in Q16 (65 536 = unit gain).
-    pub loop_gain_q16: i64,
-    /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error, Q16.
-    pub gain_loop_q16: i64,
+    pub loop_gain_q16: i32,
+    /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error,
+    /// below 2^27 (the reference loop: about 41 500; the largest valid
+    /// configuration about 4.3e7).
+    pub gain_loop: i32,
     /// Nominal DAC codes per turn, Q8.
     pub cpt_nominal_q8: u32,
     /// Clamp of the digital gain (codes per turn, Q8).
     pub cpt_min_q8: u32,
     pub cpt_max_q8: u32,
     /// Epsilon-squared correction: output bias (phase LSB, Q16) per product of two
-    /// in-step residual slopes, each in units of 2^8 phase LSB; scaled by 2^-`vib_shift`.
-    pub vib_coeff: i64,
-    pub vib_shift: u32,
+    /// in-step residual slopes, each in units of 2^8 phase LSB; Q20.
+    pub vib_coeff: i32,
     pub vibration_correction: bool,
     /// Depth dither width, bits (0 = off, at most 30).
     pub dither_bits: u32,
@@ -204,14 +206,12 @@ impl FogConfig {
             * 65_536.0
             * 65_536.0
             * crate::RAD_PER_PHASE_LSB;
-        // Largest scale (at most 2^24) that keeps |coeff| below 2^22, so the
-        // product with two slopes (2^40) cannot overflow an i64.
-        let mut vib_shift = 24;
-        while vib_shift > 0 && coeff_real.abs() * (1u64 << vib_shift) as f64 >= (1u64 << 22) as f64
-        {
-            vib_shift -= 1;
-        }
-        let vib_coeff = (coeff_real * (1u64 << vib_shift) as f64).round() as i64;
+        // Q20, saturated to an i32: |coeff_real| < 2048 (the reference
+        // instruments need about 1; only a near-zero loop gain with phi0 near
+        // the limits reaches the saturation).
+        let vib_coeff = (coeff_real * (1u64 << super::vibration::COEFF_FRAC) as f64)
+            .round()
+            .clamp(i32::MIN as f64, i32::MAX as f64) as i32;
 
         // Dither: +-codes * (ADC LSB) of level, at A*sin(phi0) level per rad.
         let amplitude = p.nominal_dc_lsb / (1.0 + p.phi0_rad.cos());
@@ -224,6 +224,15 @@ impl FogConfig {
             0
         };
 
+        // The closure scales the error by kn = k_meas_q8 * (2^32/H) / 2^24 with
+        // H >= h0_min; kn < 2^36 keeps its products with the step's sums
+        // (below 2^26) inside an i64. Only an absurdly dim nominal level
+        // (a few LSB) breaks it.
+        let h0_min = (h0_nominal * 0.25).round().max(1.0);
+        if k_meas * 256.0 * (4_294_967_296.0 / h0_min) / 16_777_216.0 >= (1u64 << 36) as f64 {
+            return Err(ConfigError::Physical);
+        }
+
         let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU;
         Ok(Self {
             params: p,
@@ -234,17 +243,16 @@ impl FogConfig {
             skip_samples: p.skip_samples,
             phi0: phase_from_rad(p.phi0_rad),
             k_meas_q8: (k_meas * 256.0).round() as u64,
-            loop_gain_q16: (p.loop_gain * 65_536.0).round() as i64,
-            gain_loop_q16: ((gain_loop * 65_536.0).round() as i64).clamp(0, (1 << 42) - 1),
+            loop_gain_q16: (p.loop_gain * 65_536.0).round() as i32,
+            gain_loop: gain_loop.round().clamp(0.0, ((1 << 27) - 1) as f64) as i32,
             cpt_nominal_q8: p.dac_codes_per_turn << 8,
             cpt_min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
             cpt_max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
             vib_coeff,
-            vib_shift,
             vibration_correction: p.vibration_correction,
             dither_bits,
             h0_nominal: h0_nominal.round() as u32,
-            h0_min: (h0_nominal * 0.25).round() as u32,
+            h0_min: h0_min as u32,
             dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,
             lock_limit: phase_from_rad(0.5 * PI),
             lock_steps: 8,

@@ -33,8 +33,9 @@ pub struct DemodSums {
 
 /// Demodulates `adc` (`n_half` half periods of `samples_per_half` samples);
 /// `carries` as [`Carries`]. `n_half` must be a multiple of 4 and at most 64
-/// (config checks it); the common sample layouts run a loop unrolled at
-/// compile time.
+/// (config checks it). The reference instruments' layouts (4 samples, 1
+/// skipped, 16 or 32 half periods) run a loop unrolled at compile time; any
+/// other layout gives the same sums through the runtime loop.
 #[inline(always)]
 pub fn demodulate(
     adc: &[u16],
@@ -49,14 +50,15 @@ pub fn demodulate(
         carries.plus.checked_shl(shift).unwrap_or(0),
         carries.minus.checked_shl(shift).unwrap_or(0),
     );
-    let adc = adc.get(..n_half * samples_per_half).unwrap_or(adc);
-    match (samples_per_half, skip) {
-        (4, 1) => fixed::<4, 1>(adc, n_half, masks),
-        (4, 2) => fixed::<4, 2>(adc, n_half, masks),
-        (2, 1) => fixed::<2, 1>(adc, n_half, masks),
-        (8, 2) => fixed::<8, 2>(adc, n_half, masks),
-        _ => any(adc, samples_per_half, skip, n_half, masks),
-    }
+    let fast = match (samples_per_half, skip, n_half) {
+        (4, 1, 16) => fixed::<4, 1, 64>(adc, masks),
+        (4, 1, 32) => fixed::<4, 1, 128>(adc, masks),
+        _ => None,
+    };
+    fast.unwrap_or_else(|| {
+        let adc = adc.get(..n_half * samples_per_half).unwrap_or(adc);
+        any(adc, samples_per_half, skip, n_half, masks)
+    })
 }
 
 /// Sum of the kept samples of one half period.
@@ -65,33 +67,47 @@ fn kept<const S: usize>(half: &[u16]) -> u32 {
     half.iter().skip(S).map(|&x| x as u32).sum()
 }
 
-/// `h` if the mask's top bit is set, else 0 (branch-free).
+/// Plus- and minus-half sums of one half of a step (`N`-sample halves), with
+/// the carried halves' sums; pair k's carry bits are bit `31 - first - k` of
+/// the masks. The carry selects by multiply-accumulate (bit x sum: one `ubfx`
+/// and one `mla` on the M4, no branch).
 #[inline(always)]
-fn if_top(mask: u32, h: u32) -> u32 {
-    h & ((mask as i32 >> 31) as u32)
+fn half_step<const N: usize, const S: usize>(
+    adc: &[u16],
+    d: &mut DemodSums,
+    (mp, mm): (u32, u32),
+    first: usize,
+) -> (u32, u32) {
+    let (mut p, mut m) = (0u32, 0u32);
+    for (k, pair) in adc.chunks_exact(2 * N).enumerate() {
+        let (plus, minus) = pair.split_at(N);
+        let (hp, hm) = (kept::<S>(plus), kept::<S>(minus));
+        p += hp;
+        m += hm;
+        let bit = 31 - ((first + k) & 31);
+        d.carried_plus += hp * ((mp >> bit) & 1);
+        d.carried_minus += hm * ((mm >> bit) & 1);
+    }
+    (p, m)
 }
 
+/// `T` = `N` samples x half periods, a compile-time length so the loops unroll;
+/// `None` if `adc` is shorter (the caller falls back to [`any`]).
+/// Plus and minus halves are summed apart and combined once at the end.
 #[inline(always)]
-fn fixed<const N: usize, const S: usize>(
+fn fixed<const N: usize, const S: usize, const T: usize>(
     adc: &[u16],
-    n_half: usize,
-    (mut mp, mut mm): (u32, u32),
-) -> DemodSums {
+    masks: (u32, u32),
+) -> Option<DemodSums> {
+    let adc: &[u16; T] = adc.first_chunk::<T>()?;
+    let (a_first, a_second) = adc.split_at(T / 2);
     let mut d = DemodSums::default();
-    let (a_first, a_second) = adc.split_at((n_half / 2 * N).min(adc.len()));
-    for (adc, acc) in [(a_first, &mut d.first), (a_second, &mut d.second)] {
-        for pair in adc.chunks_exact(2 * N) {
-            let (plus, minus) = pair.split_at(N);
-            let (hp, hm) = (kept::<S>(plus), kept::<S>(minus));
-            *acc += hp as i32 - hm as i32;
-            d.dc += hp + hm;
-            d.carried_plus += if_top(mp, hp);
-            d.carried_minus += if_top(mm, hm);
-            mp <<= 1;
-            mm <<= 1;
-        }
-    }
-    d
+    let (p1, m1) = half_step::<N, S>(a_first, &mut d, masks, 0);
+    let (p2, m2) = half_step::<N, S>(a_second, &mut d, masks, T / (4 * N));
+    d.first = p1 as i32 - m1 as i32;
+    d.second = p2 as i32 - m2 as i32;
+    d.dc = p1 + m1 + p2 + m2;
+    Some(d)
 }
 
 /// Any layout (runtime sizes); same result as [`fixed`].
@@ -113,10 +129,14 @@ fn any(
         }
         d.dc += h;
         if j % 2 == 0 {
-            d.carried_plus += if_top(mp, h);
+            if (mp as i32) < 0 {
+                d.carried_plus += h;
+            }
             mp <<= 1;
         } else {
-            d.carried_minus += if_top(mm, h);
+            if (mm as i32) < 0 {
+                d.carried_minus += h;
+            }
             mm <<= 1;
         }
     }

@@ -41,7 +41,8 @@ impl Modulator {
     /// +phi0) and returns where the drive phase carried (the 2*pi resets).
     /// `step`: feedback step (phase LSB, taken modulo a turn); `depth`: this
     /// step's phi0 (+ dither), phase LSB; `cpt_q8`: DAC codes per turn, Q8.
-    /// At most 64 half periods (32 pairs) are written.
+    /// At most 64 half periods (32 pairs) are written; the reference
+    /// instruments' 16 and 32 run a loop unrolled at compile time.
     #[inline(always)]
     pub fn write_step(
         &mut self,
@@ -52,22 +53,11 @@ impl Modulator {
     ) -> Carries {
         let d_plus = depth.wrapping_sub(step);
         let d_minus = 0u32.wrapping_sub(depth).wrapping_sub(step);
-        let cpt = cpt_q8 as u64;
-        let mut theta = self.theta;
-        let (mut plus, mut minus) = (0u32, 0u32);
-        for pair in dac.chunks_exact_mut(2).take(32) {
-            let (t1, c1) = theta.overflowing_add(d_plus);
-            let (t2, c2) = t1.overflowing_add(d_minus);
-            theta = t2;
-            plus = (plus << 1) | c1 as u32;
-            minus = (minus << 1) | c2 as u32;
-            // u32 * (<2^24) >> 40 stays below 2^16 while cpt_q8 < 2^24 (config clamps it).
-            if let [p, m] = pair {
-                *p = ((t1 as u64 * cpt) >> 40) as u16;
-                *m = ((t2 as u64 * cpt) >> 40) as u16;
-            }
-        }
-        self.theta = theta;
+        let (plus, minus) = match dac.len() {
+            16 => self.write::<16>(dac, d_plus, d_minus, cpt_q8),
+            32 => self.write::<32>(dac, d_plus, d_minus, cpt_q8),
+            _ => self.write_any(dac, d_plus, d_minus, cpt_q8),
+        };
         Carries {
             plus,
             minus,
@@ -75,6 +65,59 @@ impl Modulator {
             minus_negative: (d_minus as i32) < 0,
         }
     }
+
+    /// `H` half periods (a compile-time count, so the loop unrolls).
+    #[inline(always)]
+    fn write<const H: usize>(
+        &mut self,
+        dac: &mut [u16],
+        d_plus: Phase,
+        d_minus: Phase,
+        cpt_q8: u32,
+    ) -> (u32, u32) {
+        match dac.first_chunk_mut::<H>() {
+            Some(dac) => self.write_any(dac, d_plus, d_minus, cpt_q8),
+            None => (0, 0),
+        }
+    }
+
+    #[inline(always)]
+    fn write_any(
+        &mut self,
+        dac: &mut [u16],
+        d_plus: Phase,
+        d_minus: Phase,
+        cpt_q8: u32,
+    ) -> (u32, u32) {
+        let cpt = cpt_q8 as u64;
+        let mut theta = self.theta;
+        let (mut plus, mut minus) = (0u32, 0u32);
+        for pair in dac.chunks_exact_mut(2).take(32) {
+            // The sums' bit 32 is the carry (adds + adc on the M4).
+            let s1 = theta as u64 + d_plus as u64;
+            let t1 = s1 as u32;
+            let s2 = t1 as u64 + d_minus as u64;
+            let t2 = s2 as u32;
+            theta = t2;
+            plus = (plus << 1) | (s1 >> 32) as u32;
+            minus = (minus << 1) | (s2 >> 32) as u32;
+            if let [p, m] = pair {
+                *p = dac_word(t1, cpt);
+                *m = dac_word(t2, cpt);
+            }
+        }
+        self.theta = theta;
+        (plus, minus)
+    }
+}
+
+/// DAC code of drive phase `theta` at `cpt` codes per turn (Q8): the high
+/// word of one 32x32 multiply. theta's low 8 bits are dropped first (2^-8 of
+/// a code at most); u24 * (<2^24) >> 32 stays below 2^16 while cpt_q8 < 2^24
+/// (config clamps it).
+#[inline(always)]
+fn dac_word(theta: Phase, cpt: u64) -> u16 {
+    (((theta >> 8) as u64 * cpt) >> 32) as u16
 }
 
 impl Carries {
