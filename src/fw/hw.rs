@@ -12,18 +12,40 @@
 //!   rigs apply it on the next step); physics.md's coefficient must be re-derived
 //!   for that loop before trusting the epsilon-squared correction on the board.
 //! - Frames on USART1 (PA9) at 2 Mbaud; independent watchdog at 100 ms.
+//! - RLG: the readout's quadrature pair on PB6/PB7 (TIM4 CH1/CH2, AF2, digital
+//!   filter 8 samples) counts in encoder mode 3 (every edge of both inputs,
+//!   x4); TIM5 interrupts at 500 Hz (below the closure's priority) and runs
+//!   the RLG update: counter read and wrapping difference, thermal
+//!   compensation on sensor ticks. The three TMP117s (0x48 monoblock A, 0x49
+//!   monoblock B, 0x4A case) sit on I2C1 (PB8/PB9, `i2c.rs`); the main loop
+//!   reads them at 10 Hz and hands the readings to the update interrupt
+//!   through a queue, so no bus transfer runs in an interrupt. The closure
+//!   interrupt puts the RLG words into each frame. Coefficients come from the
+//!   build-time record (build.rs, `RLG_COEFFS`) and are checked at start.
 //!
 //! Registers are written as whole words with the bit meaning in the comment.
 
-use super::{stack, uart, FrameQueue, STEPS_PER_FRAME};
+use super::i2c::I2c1;
+use super::{stack, uart, FrameQueue, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME};
 use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::Mutex;
 use defmt_rtt as _;
+use gyro_sp::drivers::tmp117::Tmp117;
 use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
 use gyro_sp::fog::{Faults, FogConfig, FogLoop, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
-use heapless::spsc::Producer;
+use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
+use gyro_sp::rlg::{RlgChannel, RlgConfig};
+use heapless::spsc::{Consumer, Producer, Queue};
 use stm32f4::stm32f405::{self as pac, interrupt, Interrupt};
+
+/// RLG scale factor: encoder counts (quadrature edges, x4) per degree.
+const RLG_COUNTS_PER_DEG: f64 = 8_000.0;
+/// Readings from the main loop to the RLG update interrupt.
+type TempQueue = Queue<Temperatures, 2>;
+/// RLG updates so far (the main loop times the sensor reads by it).
+static RLG_TICKS: AtomicU32 = AtomicU32::new(0);
 
 const N_HALF: usize = 16;
 const N_SAMPLES: usize = 64;
@@ -41,6 +63,11 @@ struct Ctx {
     counter: u32,
     dma: pac::DMA2,
     adc: pac::ADC1,
+    rlg_cfg: RlgConfig,
+    rlg: RlgChannel,
+    encoder: pac::TIM4,
+    rlg_timer: pac::TIM5,
+    temps: Consumer<'static, Temperatures, 2>,
 }
 
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
@@ -72,6 +99,45 @@ pub fn run() -> ! {
         .afrh()
         .modify(|r, w| unsafe { w.bits((r.bits() & !0xF0) | 0x70) });
     uart::init(&dp.USART1, 42); // 84 MHz / 2 Mbaud = 42
+                                // PB6/PB7: AF2 (TIM4 CH1/CH2), the RLG quadrature pair.
+    dp.GPIOB
+        .moder()
+        .modify(|r, w| unsafe { w.bits((r.bits() & !(0xF << 12)) | (0xA << 12)) });
+    dp.GPIOB
+        .afrl()
+        .modify(|r, w| unsafe { w.bits((r.bits() & !(0xFF << 24)) | (0x22 << 24)) });
+    let mut i2c = I2c1::new(dp.I2C1, &dp.GPIOB);
+    let sensors = [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)];
+    for s in &sensors {
+        if s.init(&mut i2c).is_err() {
+            defmt::warn!(
+                "TMP117 at {=u8:#x} does not answer: its reads will be flagged",
+                s.addr
+            );
+        }
+    }
+    let thermal = ThermalConfig::from_record(&RLG_RECORD, SENSOR_EVERY as f64 / RLG_HZ as f64);
+    if thermal.coeffs_default {
+        defmt::warn!("RLG coefficient record refused: running without thermal compensation");
+    }
+    let rlg_cfg = RlgConfig::new(thermal, RLG_COUNTS_PER_DEG, RLG_HZ);
+    // TIM4 encoder: CC1S = CC2S = 01 (TI1, TI2), IC1F = IC2F = 0011 (8 samples
+    // at fCK_INT), both polarities non-inverted, SMS = 011 (x4), full 16-bit range.
+    dp.TIM4.ccmr1_input().write(|w| unsafe { w.bits(0x3131) });
+    dp.TIM4.ccer().write(|w| unsafe { w.bits(0) });
+    dp.TIM4.smcr().write(|w| unsafe { w.bits(0b011) });
+    dp.TIM4.arr().write(|w| unsafe { w.bits(0xFFFF) });
+    dp.TIM4.cr1().write(|w| unsafe { w.bits(1) }); // CEN
+                                                   // TIM5: 84 MHz / 84 = 1 MHz, / 2000 = 500 Hz update interrupt.
+    dp.TIM5.psc().write(|w| unsafe { w.bits(83) });
+    dp.TIM5
+        .arr()
+        .write(|w| unsafe { w.bits(1_000_000 / RLG_HZ - 1) });
+    dp.TIM5.dier().write(|w| unsafe { w.bits(1) }); // UIE
+    let Some(temp_queue) = cortex_m::singleton!(: TempQueue = TempQueue::new()) else {
+        reset()
+    };
+    let (mut temps_tx, temps_rx) = temp_queue.split();
 
     let params = FogParams::default();
     let Ok(cfg) = FogConfig::new(params) else {
@@ -156,7 +222,7 @@ pub fn run() -> ! {
     iwdg.kr().write(|w| unsafe { w.bits(0xCCCC) });
 
     let usart = dp.USART1;
-    let (tim1, tim2) = (dp.TIM1, dp.TIM2);
+    let (tim1, tim2, tim5) = (dp.TIM1, dp.TIM2, dp.TIM5);
     cortex_m::interrupt::free(|cs| {
         CTX.borrow(cs).replace(Some(Ctx {
             cfg,
@@ -166,19 +232,48 @@ pub fn run() -> ! {
             counter: 0,
             dma: dp.DMA2,
             adc: dp.ADC1,
+            rlg_cfg,
+            rlg: RlgChannel::default(),
+            encoder: dp.TIM4,
+            rlg_timer: tim5,
+            temps: temps_rx,
         }))
     });
     unsafe {
         cp.NVIC.set_priority(Interrupt::DMA2_STREAM0, 0);
+        cp.NVIC.set_priority(Interrupt::TIM5, 0x40);
         cortex_m::peripheral::NVIC::unmask(Interrupt::DMA2_STREAM0);
+        cortex_m::peripheral::NVIC::unmask(Interrupt::TIM5);
     }
+    cortex_m::interrupt::free(|cs| {
+        if let Some(ctx) = CTX.borrow(cs).borrow().as_ref() {
+            ctx.rlg_timer.cr1().write(|w| unsafe { w.bits(1) }); // CEN
+        }
+    });
     // Start both timers together so DAC and ADC half periods stay aligned.
     tim1.cr1().write(|w| unsafe { w.bits(1) });
     tim2.cr1().write(|w| unsafe { w.bits(1) });
-    defmt::info!("gyro-fw hw: FOG closure at 12.5 kHz");
+    defmt::info!(
+        "gyro-fw hw: FOG closure at 12.5 kHz, RLG update at {} Hz",
+        RLG_HZ
+    );
+    let mut last_read = 0u32;
     loop {
         while let Some(f) = rx.dequeue() {
             uart::write(&usart, &f.encode());
+        }
+        let ticks = RLG_TICKS.load(Ordering::Relaxed);
+        if ticks.wrapping_sub(last_read) >= SENSOR_EVERY {
+            last_read = ticks;
+            // A failed read is None: the compensation flags it and holds.
+            let t = Temperatures {
+                mono_a_q8: sensors[0].read(&mut i2c),
+                mono_b_q8: sensors[1].read(&mut i2c),
+                case_q8: sensors[2].read(&mut i2c),
+            };
+            // Full only if the update interrupt has stopped; the reading is
+            // then stale anyway.
+            let _ = temps_tx.enqueue(t);
         }
         iwdg.kr().write(|w| unsafe { w.bits(0xAAAA) });
         cortex_m::asm::wfi();
@@ -203,10 +298,12 @@ fn clocks(dp: &pac::Peripherals) {
         .write(|w| unsafe { w.bits((0b100 << 13) | (0b101 << 10) | 0b10) }); // APB2 /2, APB1 /4, SW = PLL
     while rcc.cfgr().read().bits() & 0b1100 != 0b1000 {}
     rcc.ahb1enr()
-        .modify(|r, w| unsafe { w.bits(r.bits() | (1 << 22) | 1) }); // DMA2, GPIOA
+        .modify(|r, w| unsafe { w.bits(r.bits() | (1 << 22) | 0b11) }); // DMA2, GPIOB, GPIOA
     rcc.apb2enr()
         .modify(|r, w| unsafe { w.bits(r.bits() | (1 << 12) | (1 << 8) | (1 << 4) | 1) }); // SPI1, ADC1, USART1, TIM1
-    rcc.apb1enr().modify(|r, w| unsafe { w.bits(r.bits() | 1) }); // TIM2
+    rcc.apb1enr()
+        .modify(|r, w| unsafe { w.bits(r.bits() | (1 << 21) | (1 << 3) | (1 << 2) | 1) });
+    // I2C1, TIM5, TIM4, TIM2
 }
 
 /// Closure interrupt: half transfer -> step in the first half of ADC_BUF is
@@ -235,11 +332,31 @@ fn DMA2_STREAM0() {
         ctx.adc.sr().write(|w| unsafe { w.bits(!1) });
         let out = ctx.fog.process(&ctx.cfg, adc, over_range, dac);
         ctx.counter = ctx.counter.wrapping_add(1);
+        if ctx.counter.is_multiple_of(STEPS_PER_FRAME as u32) {
+            // The frame this step completes carries the RLG counts since the last.
+            let (counts, n) = ctx.rlg.take_frame();
+            ctx.frames.set_rlg(ctx.rlg.words(&ctx.rlg_cfg, counts, n));
+        }
         if let Some(f) = ctx.frames.push(&out, ctx.counter) {
             if let Err(f) = ctx.tx.enqueue(f) {
                 ctx.frames.restore(f);
             }
         }
+    });
+}
+
+/// RLG update interrupt (500 Hz): encoder counter read and differenced; on
+/// sensor ticks the readings the main loop queued advance the compensation.
+#[interrupt]
+fn TIM5() {
+    cortex_m::interrupt::free(|cs| {
+        let mut guard = CTX.borrow(cs).borrow_mut();
+        let Some(ctx) = guard.as_mut() else { return };
+        ctx.rlg_timer.sr().write(|w| unsafe { w.bits(!1) }); // clear UIF
+        let raw = ctx.encoder.cnt().read().bits() as u16;
+        let temps = ctx.temps.dequeue();
+        ctx.rlg.update(&ctx.rlg_cfg, raw, temps.as_ref());
+        RLG_TICKS.fetch_add(1, Ordering::Relaxed);
     });
 }
 

@@ -11,7 +11,7 @@
 //! answering for a while to show the fault path. Coefficients come from the
 //! build-time record (build.rs, `RLG_COEFFS`).
 
-use super::{stack, uart, FrameQueue, STEPS_PER_FRAME};
+use super::{stack, uart, FrameQueue, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME};
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::interrupt::Mutex;
@@ -21,7 +21,6 @@ use defmt_semihosting as _;
 use gyro_sp::drivers::tmp117::Tmp117;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
-use gyro_sp::rlg::coeffs::RECORD_LEN;
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{RlgChannel, RlgConfig};
 use gyro_sp::sim::{profile::qemu_demo, Chamber, ChamberParams, FogRig, OpticsParams};
@@ -33,15 +32,10 @@ const CLOSURE_HZ: u32 = 12_500;
 const RELOAD: u32 = CORE_HZ / CLOSURE_HZ - 1;
 /// Optical power loss injected during these steps (the final rest segment).
 const POWER_LOSS: core::ops::Range<u32> = 28_500..28_750;
-/// RLG update every frame (25 closure steps, 500 Hz); sensor reads every 50
-/// updates (10 Hz).
-const RLG_HZ: u32 = CLOSURE_HZ / STEPS_PER_FRAME as u32;
-const SENSOR_EVERY: u32 = 50;
+// RLG update every frame (25 closure steps = RLG_HZ).
+const _: () = assert!(CLOSURE_HZ / STEPS_PER_FRAME as u32 == RLG_HZ);
 /// The case sensor NACKs during these RLG updates (1.0 .. 1.3 s).
 const CASE_NACK: core::ops::Range<u32> = 500..650;
-
-/// The coefficient record, built from the coefficient file by build.rs.
-static RLG_RECORD: [u8; RECORD_LEN] = *include_bytes!(concat!(env!("OUT_DIR"), "/rlg_coeffs.bin"));
 
 /// Simulated TMP117s on one I2C bus: they answer temperature reads with the
 /// chamber's readings; one address can be made to NACK.
