@@ -212,7 +212,7 @@ impl FogLoop {
                     cfg.cpt_max_q8,
                 );
                 if cfg.vibration_correction {
-                    bias = self.vibration.update(slope, cfg.vib_coeff);
+                    bias = self.vibration.update(slope, residual, cfg.vib_coeff);
                 }
             }
             let unlocked = residual.unsigned_abs() > cfg.lock_limit;

@@ -130,7 +130,8 @@ pub struct FogConfig {
     pub cpt_min_q8: u32,
     pub cpt_max_q8: u32,
     /// Epsilon-squared correction: output bias (phase LSB, Q16) per product of two
-    /// in-step residual slopes, each in units of 2^8 phase LSB; Q20.
+    /// in-step residual slope (2^8 phase LSB) and previous mean residual (phase
+    /// LSB); Q30.
     pub vib_coeff: i32,
     pub vibration_correction: bool,
     /// Depth dither width, bits (0 = off, at most 30).
@@ -198,17 +199,13 @@ impl FogConfig {
         let h0_nominal = p.nominal_dc_lsb * kept;
 
         // Epsilon-squared correction, derived in vibration.rs:
-        // d = -(2*cot(phi0)/(g*n_half)) * da * db  [rad], da, db in rad.
-        // With da, db in units of 2^8 LSB and d in LSB*2^16:
-        // d_q16 = coeff_real * da' * db', coeff_real = -(2 cot phi0/(g n)) * 2^16 * 2^16 * LSB_rad.
+        // d = -(cot(phi0)/n_half) * da * dbar  [rad], da, dbar in rad.
+        // With da in units of 2^8 LSB, dbar in LSB and d in LSB*2^16:
+        // d_q16 = coeff_real * da' * dbar', coeff_real = -(cot phi0/n) * 2^8 * LSB_rad * 2^16.
         let cot_phi0 = 1.0 / p.phi0_rad.tan();
-        let coeff_real = -(2.0 * cot_phi0 / (p.loop_gain * n_half as f64))
-            * 65_536.0
-            * 65_536.0
-            * crate::RAD_PER_PHASE_LSB;
-        // Q20, saturated to an i32: |coeff_real| < 2048 (the reference
-        // instruments need about 1; only a near-zero loop gain with phi0 near
-        // the limits reaches the saturation).
+        let coeff_real = -(cot_phi0 / n_half as f64) * 256.0 * crate::RAD_PER_PHASE_LSB * 65_536.0;
+        // Q30, saturated to an i32: |coeff_real| < 2 (the reference instruments
+        // need about 0.002; phi0 = 0.1 rad with 4 half periods needs 0.06).
         let vib_coeff = (coeff_real * (1u64 << super::vibration::COEFF_FRAC) as f64)
             .round()
             .clamp(i32::MIN as f64, i32::MAX as f64) as i32;

@@ -10,17 +10,23 @@
 //! `bias = -(cot(phi0)/2)*(n/g)*b^2` [rad per step]; with g = 1 this is
 //! physics.md's `-(1/4)*cot(phi0)*K_s*eps^2*dt_m*dt_p`.
 //!
-//! b is measured in the step itself: the residual of the second half of the step
-//! minus that of the first half, `da = (n/2)*b`. Squaring one noisy da would be
-//! biased by its noise variance; the product of da from this step and from the
-//! previous one (disjoint noise) is unbiased, so the correction adds no drift at
-//! rest. Its only lag is one step: the mean of the product is eps^2*cos(w*dt_p).
-//! `bias = -(2*cot(phi0)/(g*n)) * da_k * da_(k-1)`.
+//! Both factors are measured, so the quasi-static step is not needed: b from
+//! the step itself (the residual of the second half of the step minus that of
+//! the first half, `da = (n/2)*b`), dbar is the demodulated residual the main
+//! loop already has. Away from the quasi-static limit (vibration nearer the
+//! loop bandwidth, or a loop gain other than one) dbar lags b and the
+//! measured product follows; the model `dbar = n*b/g` would not.
+//! A product of two noisy estimates from the same samples would be biased by
+//! their noise covariance; this step's slope times the previous step's
+//! residual (disjoint samples) is unbiased, so the correction adds no drift at
+//! rest. Its only lag is one step: the mean of the product carries
+//! cos(w*dt_p), 0.995 at 200 Hz.
+//! `bias = -(cot(phi0)/n) * da_k * dbar_(k-1)`.
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct VibrationCorrection {
-    /// In-step residual slope of the previous step, 2^8 phase LSB.
-    prev_slope: i32,
+    /// Mean residual of the previous step, phase LSB.
+    prev_residual: i32,
     /// Sub-LSB part of the correction carried to the next step (phase LSB, Q16).
     frac_q16: i64,
 }
@@ -30,27 +36,28 @@ pub struct VibrationCorrection {
 const SLOPE_LIMIT: i32 = 1 << 20;
 
 /// Fraction bits of the coefficient (see [`crate::fog::FogConfig::vib_coeff`]).
-pub const COEFF_FRAC: u32 = 20;
+pub const COEFF_FRAC: u32 = 30;
 
-/// Low bits of the slope product dropped (rounded) before the coefficient:
-/// the product (2^16 LSB^2 units, at most 2^40) then fits an i32 and one
-/// 32x32 multiply scales it. The rounding step (unbiased) is under 0.1 % of
-/// the product at 1 000 deg/s^2 on the reference coil, far below its noise.
-const PRODUCT_DROP: u32 = 12;
+/// Low bits of the product (slope x residual, 2^8 LSB^2 units, below 2^51)
+/// dropped (rounded) before the coefficient, so one 32x32 multiply scales it.
+/// The step is under 0.1 % of the product at 1 000 deg/s^2 on the reference
+/// coil, and unbiased.
+const PRODUCT_DROP: u32 = 21;
 
 impl VibrationCorrection {
-    /// Takes this step's slope (2^8 LSB, any value: saturated here) and the
-    /// coefficient (Q[`COEFF_FRAC`]); returns the bias to subtract from the
-    /// output step, whole phase LSB (the fraction is carried, no loss).
+    /// Takes this step's slope (2^8 LSB, any value: saturated here), its mean
+    /// residual (phase LSB) and the coefficient (Q[`COEFF_FRAC`]); returns the
+    /// bias to subtract from the output step, whole phase LSB (the fraction is
+    /// carried, no loss).
     #[inline(always)]
-    pub fn update(&mut self, slope: i32, coeff: i32) -> i64 {
+    pub fn update(&mut self, slope: i32, residual: i32, coeff: i32) -> i64 {
         // A power-of-two range: one `ssat` on the M4.
         let slope = slope.clamp(-SLOPE_LIMIT, SLOPE_LIMIT - 1);
-        // |slope * prev| <= 2^40: after the rounded drop |p| <= 2^28.
-        let product = slope as i64 * self.prev_slope as i64;
+        // |slope * residual| <= 2^51: after the rounded drop at most 2^30.
+        let product = slope as i64 * self.prev_residual as i64;
         let p = ((product + (1 << (PRODUCT_DROP - 1))) >> PRODUCT_DROP) as i32;
-        self.prev_slope = slope;
-        // |p * coeff| < 2^59; the result is phase LSB in Q16.
+        self.prev_residual = residual;
+        // |p * coeff| <= 2^61; the result is phase LSB in Q16.
         let bias_q16 = (p as i64 * coeff as i64) >> (COEFF_FRAC - PRODUCT_DROP);
         let total = self.frac_q16 + bias_q16;
         let whole = total >> 16;
@@ -58,8 +65,8 @@ impl VibrationCorrection {
         whole
     }
 
-    /// Forget the history (after a fault: slopes across the gap are not valid).
+    /// Forget the history (after a fault: residuals across the gap are not valid).
     pub fn reset(&mut self) {
-        self.prev_slope = 0;
+        self.prev_residual = 0;
     }
 }
