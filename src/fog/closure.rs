@@ -10,6 +10,7 @@ use super::demod::demodulate;
 use super::faults::Faults;
 use super::gain_loop;
 use super::modulator::{Carries, Modulator};
+use super::saturate_i32;
 use super::vibration::VibrationCorrection;
 
 /// What one closure step produces.
@@ -57,16 +58,6 @@ pub struct FogLoop {
 /// Largest kept-sample sum of one half period, ADC LSB (15 kept samples of
 /// 16-bit codes), so the Q12 DC filter fits a u32.
 const MAX_HALF_SUM: u32 = (1 << 20) - 1;
-
-/// `x` saturated to the i32 range (compare the high word with the low
-/// word's sign: a few instructions, not a 64-bit clamp).
-#[inline(always)]
-pub(crate) fn saturate_i32(x: i64) -> i32 {
-    match i32::try_from(x) {
-        Ok(v) => v,
-        Err(_) => ((x >> 63) as i32) ^ i32::MAX,
-    }
-}
 
 /// Feedback-step clamp: +-2^40 LSB is +-256 turns, about +-1200 rad/s at K_s = 1.35 s.
 const STEP_LIMIT: i64 = 1 << 40;

@@ -23,3 +23,13 @@ pub use faults::Faults;
 pub const MAX_HALF: usize = 64;
 /// Most ADC samples per half period.
 pub const MAX_SAMPLES_PER_HALF: usize = 16;
+
+/// `x` saturated to the i32 range (compare the high word with the low
+/// word's sign: a few instructions, not a 64-bit clamp).
+#[inline(always)]
+pub(crate) fn saturate_i32(x: i64) -> i32 {
+    match i32::try_from(x) {
+        Ok(v) => v,
+        Err(_) => ((x >> 63) as i32) ^ i32::MAX,
+    }
+}

@@ -223,6 +223,8 @@ pub fn run() -> ! {
 
     let usart = dp.USART1;
     let (tim1, tim2, tim5) = (dp.TIM1, dp.TIM2, dp.TIM5);
+    // Counting from here; its interrupt stays masked until the context exists.
+    tim5.cr1().write(|w| unsafe { w.bits(1) }); // CEN
     cortex_m::interrupt::free(|cs| {
         CTX.borrow(cs).replace(Some(Ctx {
             cfg,
@@ -245,11 +247,6 @@ pub fn run() -> ! {
         cortex_m::peripheral::NVIC::unmask(Interrupt::DMA2_STREAM0);
         cortex_m::peripheral::NVIC::unmask(Interrupt::TIM5);
     }
-    cortex_m::interrupt::free(|cs| {
-        if let Some(ctx) = CTX.borrow(cs).borrow().as_ref() {
-            ctx.rlg_timer.cr1().write(|w| unsafe { w.bits(1) }); // CEN
-        }
-    });
     // Start both timers together so DAC and ADC half periods stay aligned.
     tim1.cr1().write(|w| unsafe { w.bits(1) });
     tim2.cr1().write(|w| unsafe { w.bits(1) });
