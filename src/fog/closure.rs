@@ -39,7 +39,8 @@ pub struct FogLoop {
     /// Digital gain, DAC codes per turn in Q8.
     cpt_q8: u32,
     /// Low-passed DC of one half period, ADC LSB in Q12 (below 2^32: a half
-    /// period's kept sum is below 2^20); time constant 4096 steps (0.33 s). Slow on purpose: a step's DC has a first-order term in the
+    /// period's kept sum is below 2^20); time constant 4096 steps (0.33 s).
+    /// Slow on purpose: a step's DC has a first-order term in the
     /// in-step residual slope (proportional to eps), so a fast AGC would modulate
     /// the loop gain at the vibration frequency and rectify a second eps^2 drift.
     dc_q12: u32,
@@ -169,9 +170,10 @@ impl FogLoop {
                 self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step;
             }
             let h = (self.dc_q12 >> 12).max(1);
-            let recip_h = u32::MAX / h; // 2^32 / H
-                                        // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H.
-                                        // Config bounds k_meas/h0_min so that kn < 2^36 (and this product < 2^60).
+            // 2^32 / H.
+            let recip_h = u32::MAX / h;
+            // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H. Config
+            // bounds k_meas/h0_min so that kn < 2^36 (and this product < 2^60).
             let kn = ((cfg.k_meas_q8 * recip_h as u64) >> 24) as i64;
             // Kept sums < 2^20 per half, at most 64 halves: |sum|, |diff| < 2^26;
             // kn < 2^36: both products below 2^63. The residual
