@@ -10,7 +10,7 @@ use super::demod::demodulate;
 use super::faults::Faults;
 use super::gain_loop;
 use super::modulator::{Carries, Modulator};
-use super::saturate_i32;
+use super::shr_saturate;
 use super::vibration::VibrationCorrection;
 
 /// What one closure step produces.
@@ -163,27 +163,30 @@ impl FogLoop {
             // on optical power, without correlating the gain with this step's error.
             // Frozen while the ADC clips (the DC is then wrong).
             let h_step = h_step.min(MAX_HALF_SUM);
-            if !self.dc_valid {
+            // Seeded from this step's DC, then re-seeded below with its flat value.
+            let seeding = !self.dc_valid;
+            if seeding {
                 self.dc_q12 = h_step << 12;
                 self.dc_valid = !adc_over_range;
-            } else if !adc_over_range {
-                self.dc_q12 = self.dc_q12 - (self.dc_q12 >> 12) + h_step;
             }
-            let h = (self.dc_q12 >> 12).max(1);
+            // Not below h0_min (kn's range; the DC filter can sit under it while
+            // this step's DC is above).
+            let h = (self.dc_q12 >> 12).max(cfg.h0_min).max(1);
             // 2^32 / H.
             let recip_h = u32::MAX / h;
             // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H. Config
-            // bounds k_meas/h0_min so that kn < 2^36 (and this product < 2^60).
-            let kn = ((cfg.k_meas_q8 * recip_h as u64) >> 24) as i64;
+            // bounds k_meas/h0_min so that kn < 2^31.
+            let kn = ((cfg.k_meas as u64 * recip_h as u64) >> 16) as i32;
             // Kept sums < 2^20 per half, at most 64 halves: |sum|, |diff| < 2^26;
-            // kn < 2^36: both products below 2^63. The residual
+            // kn < 2^31: both products below 2^57. The residual
             // saturates at +-half a turn: the error is periodic, so an estimate
             // beyond that only says "far out" (lock acquisition then takes
             // several steps, as it would anyway).
-            let sum = sums.first as i64 + sums.second as i64;
-            residual = saturate_i32((-sum * kn) >> 16);
-            // In-step slope, 2^8 phase LSB (the correction saturates it).
-            let slope = saturate_i32(((sums.first as i64 - sums.second as i64) * kn) >> 23);
+            let neg_sum = -(sums.first + sums.second);
+            residual = shr_saturate::<16, 32>(neg_sum as i64 * kn as i64);
+            // In-step slope, 2^8 phase LSB, saturated at +-2^20 (0.37 rad).
+            let diff = sums.first - sums.second;
+            let slope = shr_saturate::<23, 21>(diff as i64 * kn as i64);
 
             // Clipped samples still give the error's sign, so the main loop keeps
             // running through over-range (holding it could lock it there); the
@@ -207,6 +210,21 @@ impl FogLoop {
                 if cfg.vibration_correction {
                     bias = self.vibration.update(slope, residual, cfg.vib_coeff);
                 }
+                // The DC filter takes the DC the light would give with no
+                // residual: the step's spread of residual raises the DC by
+                // dc_moment * m (config.rs), m >= 0 in ADC LSB x phase LSB.
+                // |diff| < 2^27, |slope * spread| < 2^29, |sum| < 2^27,
+                // |residual| < 2^31: |m| < 2^58 and its high word below 2^26
+                // (dropping the low word costs under 1e-4 of the DC).
+                let m = diff as i64 * slope.wrapping_mul(cfg.dc_spread_q8) as i64
+                    + neg_sum as i64 * residual as i64;
+                let excess = ((m >> 32) * cfg.dc_moment_q60 as i64) >> 28;
+                let h_flat = (h_step as i32 - excess as i32).clamp(0, MAX_HALF_SUM as i32) as u32;
+                self.dc_q12 = if seeding {
+                    h_flat << 12
+                } else {
+                    self.dc_q12 - (self.dc_q12 >> 12) + h_flat
+                };
             }
             let unlocked = residual.unsigned_abs() > cfg.lock_limit;
             self.unlocked_steps = if unlocked {

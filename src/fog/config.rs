@@ -116,8 +116,8 @@ pub struct FogConfig {
     /// phi0 as [`Phase`] LSB.
     pub phi0: Phase,
     /// Residual per normalised demodulator count: `cot(phi0/2) * 2^32/(2*pi*n_half)`
-    /// in Q8 (phase LSB * 2^8 per unit of sum(sign*h)/H0).
-    pub k_meas_q8: u64,
+    /// (phase LSB per unit of sum(sign*h)/H0; dither-corrected, see `new`).
+    pub k_meas: u32,
     /// Main-loop gain in Q16 (65 536 = unit gain).
     pub loop_gain_q16: i32,
     /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error,
@@ -133,6 +133,11 @@ pub struct FogConfig {
     /// in-step residual slope (2^8 phase LSB) and previous mean residual (phase
     /// LSB); Q30.
     pub vib_coeff: i32,
+    /// DC moment correction: weight of the in-step spread, 2^8 * 2(n^2-1)/(3n^2).
+    pub dc_spread_q8: i32,
+    /// DC excess (ADC LSB of one half period's kept sum) per unit of the
+    /// moment m (ADC LSB x phase LSB), Q60: -(cot(phi0)/(2n)) * 2*pi/2^32.
+    pub dc_moment_q60: i32,
     pub vibration_correction: bool,
     /// Depth dither width, bits (0 = off, at most 30).
     pub dither_bits: u32,
@@ -194,7 +199,6 @@ impl FogConfig {
         let k_sagnac_s = TAU * p.fiber_length_m * p.coil_diameter_m / (p.wavelength_m * C_LIGHT);
         let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
         let lsb_per_rad = 4_294_967_296.0 / TAU;
-        let k_meas = cot_half * lsb_per_rad / n_half as f64;
         let kept = (p.samples_per_half - p.skip_samples) as f64;
         let h0_nominal = p.nominal_dc_lsb * kept;
 
@@ -221,12 +225,48 @@ impl FogConfig {
             0
         };
 
-        // The closure scales the error by kn = k_meas_q8 * (2^32/H) / 2^24 with
-        // H >= h0_min; kn < 2^36 keeps its products with the step's sums
-        // (below 2^26) inside an i64. Only an absurdly dim nominal level
-        // (a few LSB) breaks it.
+        // Residual per normalised demodulator count. With depth d (the dither),
+        // the error slope is A*sin(phi0 + d) and the DC A*(1 + cos(phi0 + d)):
+        // over a uniform dither of half width w, e = <d^2>/2 = w^2/6 lowers the
+        // slope by (1 - e) and moves the DC to A*(1 + c - c*e) (c = cos phi0),
+        // so the unit-gain scale is cot(phi0/2)/n times (1 + c - c*e)/((1 + c)(1 - e)):
+        // +1.7 % at 7pi/8 with the 12-bit ADC's dither. (The residual's own
+        // spread moves the DC the same way; the closure measures that per step.)
+        let c = p.phi0_rad.cos();
+        let w = if dither_bits > 0 {
+            (1u64 << (dither_bits - 1)) as f64 / lsb_per_rad
+        } else {
+            0.0
+        };
+        let e = w * w / 6.0;
+        let k_meas =
+            cot_half * lsb_per_rad / n_half as f64 * (1.0 + c - c * e) / ((1.0 + c) * (1.0 - e));
+
+        // DC moment correction (closure.rs): one half period's kept DC is
+        // A*(1 + c*<cos delta>), so a residual spread raises it by
+        // -A*c*<delta^2>/2 (near the dark fringe: 20 % at 7pi/8, 6.25 kHz,
+        // 50 000 deg/s^2), which would lower the loop gain as much. Over a step,
+        // delta_j = dbar + (j - (n-1)/2)*b; with sum = -n*A*sin(phi0)*dbar,
+        // diff = first - second = A*sin(phi0)*(n/2)*da and b = 2*da/n:
+        // A*<delta^2> = (m_rad)/(n*sin phi0), m_rad = 2(n^2-1)/(3n^2)*diff*da - sum*dbar,
+        // so the excess is -(cot(phi0)/(2n)) * m_rad. In the closure's units
+        // (residual in phase LSB, slope in 2^8 LSB) m = spread_q8*diff*slope -
+        // sum*residual (>= 0) and the excess is dc_moment * RAD * m.
+        let nf = n_half as f64;
+        let dc_spread_q8 = (256.0 * 2.0 * (nf * nf - 1.0) / (3.0 * nf * nf)).round() as i32;
+        let dc_moment = -(1.0 / p.phi0_rad.tan()) / (2.0 * nf) * crate::RAD_PER_PHASE_LSB;
+        // Q60: below 2^31 for every valid depth (|cot| <= 10, n >= 4).
+        let dc_moment_q60 = (dc_moment * (1u64 << 60) as f64)
+            .round()
+            .clamp(i32::MIN as f64, i32::MAX as f64) as i32;
+
+        // The closure scales the error by kn = k_meas * (2^32/H) / 2^16 with
+        // H >= h0_min; kn < 2^31 makes its products with the step's sums
+        // (below 2^27) single 32x32 multiplies. That needs the operating
+        // point's DC above about 700 LSB per sample at 3pi/4 (45 codes of a
+        // 12-bit ADC); a dimmer nominal level is refused.
         let h0_min = (h0_nominal * 0.25).round().max(1.0);
-        if k_meas * 256.0 * (4_294_967_296.0 / h0_min) / 16_777_216.0 >= (1u64 << 36) as f64 {
+        if k_meas >= u32::MAX as f64 || k_meas * 65_536.0 / h0_min >= i32::MAX as f64 {
             return Err(ConfigError::Physical);
         }
 
@@ -239,13 +279,15 @@ impl FogConfig {
             samples_per_half: p.samples_per_half,
             skip_samples: p.skip_samples,
             phi0: phase_from_rad(p.phi0_rad),
-            k_meas_q8: (k_meas * 256.0).round() as u64,
+            k_meas: k_meas.round() as u32,
             loop_gain_q16: (p.loop_gain * 65_536.0).round() as i32,
             gain_loop: gain_loop.round().clamp(0.0, ((1 << 27) - 1) as f64) as i32,
             cpt_nominal_q8: p.dac_codes_per_turn << 8,
             cpt_min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
             cpt_max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
             vib_coeff,
+            dc_spread_q8,
+            dc_moment_q60,
             vibration_correction: p.vibration_correction,
             dither_bits,
             h0_nominal: h0_nominal.round() as u32,

@@ -24,12 +24,16 @@ pub const MAX_HALF: usize = 64;
 /// Most ADC samples per half period.
 pub const MAX_SAMPLES_PER_HALF: usize = 16;
 
-/// `x` saturated to the i32 range (compare the high word with the low
-/// word's sign: a few instructions, not a 64-bit clamp).
+/// `x >> S` saturated to the signed `B`-bit range (`S + B` in 33..=64, `B` <= 32).
+/// The high word alone decides whether it fits, so this is one `ssat`, a compare
+/// and a select on the M4, not a 64-bit clamp.
 #[inline(always)]
-pub(crate) fn saturate_i32(x: i64) -> i32 {
-    match i32::try_from(x) {
-        Ok(v) => v,
-        Err(_) => ((x >> 63) as i32) ^ i32::MAX,
+pub fn shr_saturate<const S: u32, const B: u32>(x: i64) -> i32 {
+    let hi = (x >> 32) as i32;
+    let lim = 1i32 << (S + B - 33);
+    if hi.clamp(-lim, lim - 1) == hi {
+        (x >> S) as i32
+    } else {
+        (hi >> 31) ^ (i32::MAX >> (32 - B))
     }
 }

@@ -27,13 +27,14 @@
 pub struct VibrationCorrection {
     /// Mean residual of the previous step, phase LSB.
     prev_residual: i32,
-    /// Sub-LSB part of the correction carried to the next step (phase LSB, Q16).
-    frac_q16: i64,
+    /// Sub-LSB part of the correction carried to the next step (phase LSB,
+    /// Q[`FRAC_BITS`], in [0, 1)).
+    frac: i64,
 }
 
-/// Slopes are saturated here (2^8 LSB units, about 0.37 rad): beyond that the
-/// loop is not tracking and the correction is meaningless.
-const SLOPE_LIMIT: i32 = 1 << 20;
+/// Slopes are saturated to this (2^8 LSB units, about 0.37 rad): beyond that
+/// the loop is not tracking and the correction is meaningless.
+pub const SLOPE_LIMIT: i32 = 1 << 20;
 
 /// Fraction bits of the coefficient (see [`crate::fog::FogConfig::vib_coeff`]).
 pub const COEFF_FRAC: u32 = 30;
@@ -43,6 +44,9 @@ pub const COEFF_FRAC: u32 = 30;
 /// The step is under 0.1 % of the product at 1 000 deg/s^2 on the reference
 /// coil, and unbiased.
 const PRODUCT_DROP: u32 = 21;
+
+/// Fraction bits of p * coeff in phase LSB (the coefficient's output is Q16).
+const FRAC_BITS: u32 = COEFF_FRAC - PRODUCT_DROP + 16;
 
 impl VibrationCorrection {
     /// Takes this step's slope (2^8 LSB, any value: saturated here), its mean
@@ -57,11 +61,11 @@ impl VibrationCorrection {
         let product = slope as i64 * self.prev_residual as i64;
         let p = ((product + (1 << (PRODUCT_DROP - 1))) >> PRODUCT_DROP) as i32;
         self.prev_residual = residual;
-        // |p * coeff| <= 2^61; the result is phase LSB in Q16.
-        let bias_q16 = (p as i64 * coeff as i64) >> (COEFF_FRAC - PRODUCT_DROP);
-        let total = self.frac_q16 + bias_q16;
-        let whole = total >> 16;
-        self.frac_q16 = total - (whole << 16);
+        // |p * coeff| <= 2^61, phase LSB in Q[`FRAC_BITS`];
+        // the fraction below one LSB waits for the next step.
+        let total = self.frac + p as i64 * coeff as i64;
+        let whole = total >> FRAC_BITS;
+        self.frac = total & ((1 << FRAC_BITS) - 1);
         whole
     }
 
