@@ -244,8 +244,8 @@ impl FogConfig {
 
         // DC moment correction (closure.rs): one half period's kept DC is
         // A*(1 + c*<cos delta>), so a residual spread raises it by
-        // -A*c*<delta^2>/2 (near the dark fringe: 20 % at 7pi/8, 6.25 kHz,
-        // 50 000 deg/s^2), which would lower the loop gain as much. Over a step,
+        // -A*c*<delta^2>/2 (near the dark fringe: about 12 % at 7pi/8,
+        // 6.25 kHz, 50 000 deg/s^2), which would lower the loop gain as much. Over a step,
         // delta_j = dbar + (j - (n-1)/2)*b; with sum = -n*A*sin(phi0)*dbar,
         // diff = first - second = A*sin(phi0)*(n/2)*da and b = 2*da/n:
         // A*<delta^2> = (m_rad)/(n*sin phi0), m_rad = 2(n^2-1)/(3n^2)*diff*da - sum*dbar,

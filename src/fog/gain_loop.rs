@@ -59,10 +59,10 @@ pub fn carry_count(mask: u32, pairs: i32) -> u32 {
 /// `recip_h`: 2^32 / H (H = DC of one half period's kept samples).
 #[inline(always)]
 pub fn update(cpt_q8: u32, err: i32, gain: i32, recip_h: u32, min: u32, max: u32) -> u32 {
-    // |err| <= 2^20 (beyond is not a gain error but a lost loop).
-    let err = err.clamp(-(1 << 20), (1 << 20) - 1) as i64; // one `ssat`
-                                                           // err/H in Q24, saturated at |err/H| < 16 (a 25 % gain error, the
-                                                           // clamp's end, gives a few units): only a wild start converges slower.
+    // |err| <= 2^20 (beyond is not a gain error but a lost loop): one `ssat`.
+    let err = err.clamp(-(1 << 20), (1 << 20) - 1) as i64;
+    // err/H in Q24, saturated at |err/H| < 16 (a 25 % gain error, the
+    // clamp's end, gives a few units): only a wild start converges slower.
     let e_q24 = super::shr_saturate::<8, 29>(err * recip_h as i64) as i64;
     // Q24 x gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
     let delta = ((e_q24 * gain as i64 + (1 << 23)) >> 24) as i32;

@@ -34,7 +34,7 @@ pub struct VibrationCorrection {
 
 /// Slopes are saturated to this (2^8 LSB units, about 0.37 rad): beyond that
 /// the loop is not tracking and the correction is meaningless.
-pub const SLOPE_LIMIT: i32 = 1 << 20;
+const SLOPE_LIMIT: i32 = 1 << 20;
 
 /// Fraction bits of the coefficient (see [`crate::fog::FogConfig::vib_coeff`]).
 pub const COEFF_FRAC: u32 = 30;
