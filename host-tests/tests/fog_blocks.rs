@@ -18,29 +18,36 @@ fn reference(adc: &[u16], n: usize, skip: usize, halves: usize, c: &Carries) -> 
         d.dc += h;
         let pair_bit = halves / 2 - 1 - j / 2;
         if j % 2 == 0 && c.plus >> pair_bit & 1 == 1 {
-            d.carried_plus += h;
+            d.carried += h as i32;
         }
         if j % 2 == 1 && c.minus >> pair_bit & 1 == 1 {
-            d.carried_minus += h;
+            d.carried -= h as i32;
         }
     }
     d
 }
 
-/// The multiply-based count of short carry masks against the plain count,
-/// every 8-bit mask; longer masks take the general count.
+/// The table-based count and index moment of carry masks against the plain
+/// bit loop, every 8- and 16-bit mask; bits above the step's pairs ignored.
 #[test]
-fn carry_count_matches_count_ones() {
-    use gyro_sp::fog::gain_loop::carry_count;
-    for m in 0..256u32 {
-        assert_eq!(carry_count(m, 8), m.count_ones(), "mask {m:#x}");
-        assert_eq!(
-            carry_count(m | 0xFF00, 8),
-            m.count_ones(),
-            "bits above 8 ignored"
-        );
+fn mask_moment_matches_bit_loop() {
+    use gyro_sp::fog::gain_loop::moment;
+    let naive = |m: u32, pairs: u32| {
+        let m = m & ((1u64 << pairs) - 1) as u32;
+        let weighted: u32 = (0..32).filter(|b| (m >> b) & 1 == 1).sum();
+        (m.count_ones(), weighted)
+    };
+    for m in 0..65_536u32 {
+        for pairs in [2, 4, 6, 8, 10, 16, 32] {
+            let mask = m | (m << 16) | 0x8000_0000;
+            let got = moment(mask, pairs as i32);
+            assert_eq!(
+                (got.count, got.weighted),
+                naive(mask, pairs),
+                "mask {mask:#x} pairs {pairs}"
+            );
+        }
     }
-    assert_eq!(carry_count(0xFFFF_0F0F, 16), 24);
 }
 
 /// `x >> S` clamped to `B` signed bits, the slow way.

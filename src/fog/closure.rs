@@ -49,6 +49,8 @@ pub struct FogLoop {
     modulator: Modulator,
     /// Where the DAC words now being applied reset (used in the next call).
     carries: Carries,
+    /// Their depth dither's gain factor less one, Q32 (see `next_dither`).
+    dither_fm1_q32: i32,
     vibration: VibrationCorrection,
     unlocked_steps: u16,
     faults: Faults,
@@ -72,6 +74,7 @@ impl FogLoop {
             dc_valid: false,
             modulator: Modulator::default(),
             carries: Carries::default(),
+            dither_fm1_q32: 0,
             vibration: VibrationCorrection::default(),
             unlocked_steps: 0,
             faults: Faults::default(),
@@ -81,26 +84,33 @@ impl FogLoop {
 
     /// Writes the first step's DAC words (before any ADC data exists).
     pub fn start(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
-        let depth = self.next_depth(cfg);
         if let Some(dac) = dac.get_mut(..cfg.n_half) {
-            self.carries = self
-                .modulator
-                .write_step(self.step as u32, depth, self.cpt_q8, dac);
+            self.write_next(cfg, dac);
         }
     }
 
-    /// phi0 plus a uniform dither in [-2^(dither_bits-1), 2^(dither_bits-1)) LSB
+    /// Writes the next step's DAC words at depth phi0 + r, r the depth dither,
+    /// uniform in [-2^(dither_bits-1), 2^(dither_bits-1)) phase LSB
     /// (xorshift32; a golden-ratio sequence was tried and its lines beat with
-    /// the reset pattern at some rates).
+    /// the reset pattern at some rates), and keeps r's gain factor for the
+    /// step that will demodulate these words.
     #[inline(always)]
-    fn next_depth(&mut self, cfg: &FogConfig) -> u32 {
+    fn write_next(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
         let mut x = self.dither;
         x ^= x << 13;
         x ^= x >> 17;
         x ^= x << 5;
         self.dither = x;
         let r = (x as i32).checked_shr(32 - cfg.dither_bits).unwrap_or(0); // bits = 0: off
-        cfg.phi0.wrapping_add_signed(r)
+                                                                           // 1 - r*cot(phi0) less one, Q32, from x = r * 2^(32 - bits) (the
+                                                                           // dropped low bits are under 2^-bits of it).
+        self.dither_fm1_q32 = ((x as i32 as i64 * cfg.dither_gain as i64) >> 32) as i32;
+        self.carries = self.modulator.write_step(
+            self.step as u32,
+            cfg.phi0.wrapping_add_signed(r),
+            self.cpt_q8,
+            dac,
+        );
     }
 
     /// One closure step. `adc`: `cfg.n_samples` samples of the step just applied;
@@ -171,12 +181,17 @@ impl FogLoop {
             }
             // Not below h0_min (kn's range; the DC filter can sit under it while
             // this step's DC is above).
-            let h = (self.dc_q12 >> 12).max(cfg.h0_min).max(1);
+            let h = (self.dc_q12 >> 12).max(cfg.h0_min).max(2);
             // 2^32 / H.
             let recip_h = u32::MAX / h;
-            // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H. Config
-            // bounds k_meas/h0_min so that kn < 2^31.
+            // Residual per unit sum(sign*h), phase LSB in Q16: k_meas/H, times
+            // the dither's factor for this step's depth (1 - r*cot(phi0)):
+            // undone per step, the dither's slope change would multiply the
+            // residual by a random gain, a white error that grows with the
+            // residual under vibration. Config bounds k_meas/h0_min times the
+            // factor so that kn < 2^31; the factor is one `smmla`.
             let kn = ((cfg.k_meas as u64 * recip_h as u64) >> 16) as i32;
+            let kn = kn + ((kn as i64 * self.dither_fm1_q32 as i64) >> 32) as i32;
             // Kept sums < 2^20 per half, at most 64 halves: |sum|, |diff| < 2^26;
             // kn < 2^31: both products below 2^57. The residual
             // saturates at +-half a turn: the error is periodic, so an estimate
@@ -238,12 +253,10 @@ impl FogLoop {
                 self.faults.set(Faults::OUT_OF_LOCK, false);
             }
         }
-        let out = self.output(measured, residual, bias, h_step);
-        let depth = self.next_depth(cfg);
-        self.carries = self
-            .modulator
-            .write_step(self.step as u32, depth, self.cpt_q8, dac);
-        out
+        // The DAC words first: written straight from registers (built
+        // after the output, they were spilled to the stack).
+        self.write_next(cfg, dac);
+        self.output(measured, residual, bias, h_step)
     }
 
     fn output(&self, measured: i64, residual: i32, bias: i64, dc: u32) -> ClosureOutput {

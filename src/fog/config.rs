@@ -86,7 +86,10 @@ pub enum ConfigError {
     /// Closure period is not a whole multiple of 4 half periods (each half of a
     /// step holds whole +-phi0 pairs), or too many.
     HalfPeriods,
-    /// Samples per half period or skipped samples out of range.
+    /// Samples per half period or skipped samples out of range, or more
+    /// kept samples per step than the 2*pi loop's 32-bit estimate holds
+    /// (n_half^2 * kept < 8192: 16 half periods take up to 15 kept samples,
+    /// 32 up to 7, 64 one).
     Samples,
     /// phi0 outside [0.1, pi - 0.1] rad.
     Phi0,
@@ -120,9 +123,10 @@ pub struct FogConfig {
     pub k_meas: u32,
     /// Main-loop gain in Q16 (65 536 = unit gain).
     pub loop_gain_q16: i32,
-    /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error,
-    /// below 2^27 (the reference loop: about 41 500; the largest valid
-    /// configuration about 4.3e7).
+    /// 2*pi-loop gain: DAC Q8 codes-per-turn per unit normalised reset error
+    /// (sum c_j*h_j / H), divided by n_half (the estimate comes n times
+    /// larger), Q4; below 2^27 (the reference loop: about 41 500; the largest
+    /// valid configuration about 4.3e7).
     pub gain_loop: i32,
     /// Nominal DAC codes per turn, Q8.
     pub cpt_nominal_q8: u32,
@@ -139,8 +143,15 @@ pub struct FogConfig {
     /// moment m (ADC LSB x phase LSB), Q60: -(cot(phi0)/(2n)) * 2*pi/2^32.
     pub dc_moment_q60: i32,
     pub vibration_correction: bool,
-    /// Depth dither width, bits (0 = off, at most 30).
+    /// Depth dither width, bits (0 = off, at most 28).
     pub dither_bits: u32,
+    /// Per-step gain factor of the dither: a step of depth phi0 + r has the
+    /// error slope sin(phi0 + r), so its error is scaled by 1 - r*cot(phi0).
+    /// With the dither drawn as r = x >> (32 - dither_bits) (x an i32),
+    /// (f - 1) * 2^32 = (x * dither_gain) >> 32: dither_gain =
+    /// -cot(phi0) * 2*pi * 2^dither_bits, below 2^30 in magnitude because the
+    /// width is bounded by |r*cot(phi0)| <= 1/8.
+    pub dither_gain: i32,
     /// Kept-sample sum of one half period at the nominal operating point, LSB.
     pub h0_nominal: u32,
     /// Dark level of one half period's kept-sample sum, LSB.
@@ -178,6 +189,7 @@ impl FogConfig {
         if p.samples_per_half == 0
             || p.samples_per_half > MAX_SAMPLES_PER_HALF
             || p.skip_samples >= p.samples_per_half
+            || n_half * n_half * (p.samples_per_half - p.skip_samples) >= 8192
         {
             return Err(ConfigError::Samples);
         }
@@ -200,13 +212,13 @@ impl FogConfig {
         let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
         let lsb_per_rad = 4_294_967_296.0 / TAU;
         let kept = (p.samples_per_half - p.skip_samples) as f64;
+        let cot_phi0 = 1.0 / p.phi0_rad.tan();
         let h0_nominal = p.nominal_dc_lsb * kept;
 
         // Epsilon-squared correction, derived in vibration.rs:
         // d = -(cot(phi0)/n_half) * da * dbar  [rad], da, dbar in rad.
         // With da in units of 2^8 LSB, dbar in LSB and d in LSB*2^16:
         // d_q16 = coeff_real * da' * dbar', coeff_real = -(cot phi0/n) * 2^8 * LSB_rad * 2^16.
-        let cot_phi0 = 1.0 / p.phi0_rad.tan();
         let coeff_real = -(cot_phi0 / n_half as f64) * 256.0 * crate::RAD_PER_PHASE_LSB * 65_536.0;
         // Q30, saturated to an i32: |coeff_real| < 2 (the reference instruments
         // need about 0.002; phi0 = 0.1 rad with 4 half periods needs 0.06).
@@ -219,28 +231,47 @@ impl FogConfig {
         let code_lsb = (1u32 << (16 - p.adc_bits.clamp(1, 16))) as f64;
         let half_width_rad =
             p.dither_adc_codes.max(0.0) * code_lsb / (amplitude * p.phi0_rad.sin());
-        let dither_bits = if p.dither_adc_codes > 0.0 {
+        let mut dither_bits = if p.dither_adc_codes > 0.0 {
             ((2.0 * half_width_rad * lsb_per_rad).log2().round() as u32).clamp(1, 28)
         } else {
             0
         };
+        // The closure undoes each step's slope change to first order, 1 -
+        // r*cot(phi0); a dither wider than |r*cot(phi0)| = 1/8 is narrowed.
+        while dither_bits > 1
+            && (1u64 << (dither_bits - 1)) as f64 / lsb_per_rad * cot_phi0.abs() > 0.125
+        {
+            dither_bits -= 1;
+        }
+        let dither_gain = if dither_bits > 0 {
+            (-cot_phi0 * TAU * (1u64 << dither_bits) as f64).round() as i32
+        } else {
+            0
+        };
 
-        // Residual per normalised demodulator count. With depth d (the dither),
-        // the error slope is A*sin(phi0 + d) and the DC A*(1 + cos(phi0 + d)):
-        // over a uniform dither of half width w, e = <d^2>/2 = w^2/6 lowers the
-        // slope by (1 - e) and moves the DC to A*(1 + c - c*e) (c = cos phi0),
-        // so the unit-gain scale is cot(phi0/2)/n times (1 + c - c*e)/((1 + c)(1 - e)):
-        // +1.7 % at 7pi/8 with the 12-bit ADC's dither. (The residual's own
-        // spread moves the DC the same way; the closure measures that per step.)
+        // Residual per normalised demodulator count. With depth phi0 + r (the
+        // dither) the error slope is A*sin(phi0 + r), which the closure scales
+        // by 1 - r*cot(phi0), and the DC A*(1 + cos(phi0 + r)). Over a uniform
+        // dither of half width w the mean slope is A*sin(phi0)*G, G = <cos r> -
+        // cot^2(phi0)*<r sin r> = sin(w)/w - cot^2(phi0)*(sin w - w cos w)/w,
+        // and the DC A*(1 + c*sin(w)/w) (c = cos phi0), so the unit-gain scale
+        // is cot(phi0/2)/n times (1 + c*sin(w)/w)/((1 + c)*G): +1.7 % at 7pi/8
+        // with the 12-bit ADC's dither. (The residual's own spread moves the
+        // DC the same way; the closure measures that per step.)
         let c = p.phi0_rad.cos();
         let w = if dither_bits > 0 {
             (1u64 << (dither_bits - 1)) as f64 / lsb_per_rad
         } else {
             0.0
         };
-        let e = w * w / 6.0;
+        let (sinc, r_sin) = if w > 0.0 {
+            (w.sin() / w, (w.sin() - w * w.cos()) / w)
+        } else {
+            (1.0, 0.0)
+        };
+        let slope_mean = sinc - cot_phi0 * cot_phi0 * r_sin;
         let k_meas =
-            cot_half * lsb_per_rad / n_half as f64 * (1.0 + c - c * e) / ((1.0 + c) * (1.0 - e));
+            cot_half * lsb_per_rad / n_half as f64 * (1.0 + c * sinc) / ((1.0 + c) * slope_mean);
 
         // DC moment correction (closure.rs): one half period's kept DC is
         // A*(1 + c*<cos delta>), so a residual spread raises it by
@@ -265,12 +296,16 @@ impl FogConfig {
         // (below 2^27) single 32x32 multiplies. That needs the operating
         // point's DC above about 700 LSB per sample at 3pi/4 (45 codes of a
         // 12-bit ADC); a dimmer nominal level is refused.
-        let h0_min = (h0_nominal * 0.25).round().max(1.0);
-        if k_meas >= u32::MAX as f64 || k_meas * 65_536.0 / h0_min >= i32::MAX as f64 {
+        let h0_min = (h0_nominal * 0.25).round().max(2.0);
+        // The dither's per-step factor reaches 1 + |cot(phi0)|*w (at most 9/8).
+        let dither_max = 1.0 + cot_phi0.abs() * w;
+        if k_meas >= u32::MAX as f64 || k_meas * 65_536.0 / h0_min * dither_max >= i32::MAX as f64 {
             return Err(ConfigError::Physical);
         }
 
-        let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU;
+        let gain_loop = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU
+            * 16.0
+            / n_half as f64;
         Ok(Self {
             params: p,
             k_sagnac_s,
@@ -290,6 +325,7 @@ impl FogConfig {
             dc_moment_q60,
             vibration_correction: p.vibration_correction,
             dither_bits,
+            dither_gain,
             h0_nominal: h0_nominal.round() as u32,
             h0_min: h0_min as u32,
             dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,

@@ -26,9 +26,10 @@ pub struct DemodSums {
     pub second: i32,
     /// sum(h_j): the detector DC over the step.
     pub dc: u32,
-    /// sum(h_j) over the plus (minus) half periods whose drive phase carried.
-    pub carried_plus: u32,
-    pub carried_minus: u32,
+    /// sum(h_j) over the plus half periods whose drive phase carried, less
+    /// the same over the minus half periods (the 2*pi loop needs only the
+    /// difference; one accumulator less in the unrolled loop).
+    pub carried: i32,
 }
 
 /// Demodulates `adc` (`n_half` half periods of `samples_per_half` samples);
@@ -85,8 +86,7 @@ fn half_step<const N: usize, const S: usize>(
         p += hp;
         m += hm;
         let bit = 31 - ((first + k) & 31);
-        d.carried_plus += hp * ((mp >> bit) & 1);
-        d.carried_minus += hm * ((mm >> bit) & 1);
+        d.carried += (hp * ((mp >> bit) & 1)) as i32 - (hm * ((mm >> bit) & 1)) as i32;
     }
     (p, m)
 }
@@ -130,12 +130,12 @@ fn any(
         d.dc += h;
         if j % 2 == 0 {
             if (mp as i32) < 0 {
-                d.carried_plus += h;
+                d.carried += h as i32;
             }
             mp <<= 1;
         } else {
             if (mm as i32) < 0 {
-                d.carried_minus += h;
+                d.carried -= h as i32;
             }
             mm <<= 1;
         }

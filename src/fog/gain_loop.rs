@@ -9,63 +9,141 @@
 use super::demod::DemodSums;
 use super::modulator::Carries;
 
-/// Returns sum_j w_j * (h_j - mean(h)) - r_j * e over the step, w_j = r_j *
-/// sign_j, r_j the reset direction (see [`Carries::weight`]) and e the step's
-/// mean of sign_j * h_j, from the demodulator's
-/// sums: over plus halves sum(w*h) = carried - [negative]*all, over minus
-/// halves [negative]*all - carried. |result| < 2^27 (kept sums below 2^20,
-/// at most 64 half periods).
+/// Returns n * (sum_j c_j * h_j) over the step (n = `n_half`), exact: no
+/// division, so no rounding that correlates with the resets. The weights are
+/// c_j = w_j - W/n - (R/n)*sign_j, w_j = r_j * sign_j, r_j the reset
+/// direction (see [`Carries::weight`]), W = sum w_j, R = sum r_j: the mean
+/// level and the step's common residual (mean of sign_j * h_j: the main
+/// loop's error, or the lag under acceleration) drop out, so only the
+/// resets' own phase error remains.
+///
+/// With the residual delta_j = dbar + a*t_j + e_j (t_j = j - (n-1)/2, e_j the
+/// reset error) the level is h_j = H - sign_j*k*delta_j, and
+/// sum c_j*h_j = -k*(sum c_j*sign_j*e_j) - k*a*S1, S1 = sum_j r_j*(t_j +
+/// sign_j/2). Under a periodic vibration the resets fall at the same places
+/// every cycle and S1 correlates with a: the slope's share is taken out with
+/// k*a = 4*(first - second)/n^2 (rounded to the nearest unit, so without
+/// bias).
+///
+/// Range: with h_max the largest kept sum of one half period (kept samples
+/// x 2^16), |n*c_j| <= 3n and |S1| <= n^2/4, so the result is below
+/// 4*n^2*h_max, under 2^31 for the layouts config accepts (n^2 * kept <
+/// 8192); the arithmetic wraps on purpose only beyond that.
 #[inline(always)]
 pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
     let pairs = (n_half / 2) as i32;
-    let (neg_p, neg_m) = (carries.plus_negative as i32, carries.minus_negative as i32);
-    // Plus and minus totals from dc = P + M and P - M = first + second.
-    let diff = sums.first + sums.second;
-    let plus_all = (sums.dc as i32 + diff) / 2;
-    let minus_all = (sums.dc as i32 - diff) / 2;
-    let weighted =
-        sums.carried_plus as i32 - neg_p * plus_all + neg_m * minus_all - sums.carried_minus as i32;
-    let (n_plus, n_minus) = (
-        carry_count(carries.plus, pairs) as i32,
-        carry_count(carries.minus, pairs) as i32,
-    );
+    let n = n_half.max(4) as i32;
+    let (neg_p, neg_m) = (carries.plus_negative, carries.minus_negative);
+    // dc = P + M < 2^26 and diff = P - M = first + second: P = (dc + diff)/2
+    // exactly (dc + diff = 2P >= 0).
+    let dc = sums.dc as i32;
+    let diff = sums.first.wrapping_add(sums.second);
+    let plus_all = (dc.wrapping_add(diff) as u32 >> 1) as i32;
+    let minus_all = dc.wrapping_sub(plus_all);
+    let mut weighted = sums.carried;
+    if neg_p {
+        weighted = weighted.wrapping_sub(plus_all);
+    }
+    if neg_m {
+        weighted = weighted.wrapping_add(minus_all);
+    }
+    let (plus, minus) = (moment(carries.plus, pairs), moment(carries.minus, pairs));
+    let (n_plus, n_minus) = (plus.count as i32, minus.count as i32);
+    let (neg_p, neg_m) = (neg_p as i32, neg_m as i32);
     let w_sum = n_plus - n_minus + (neg_m - neg_p) * pairs;
-    let mean = (sums.dc / n_half.max(1)) as i32;
-    // The step's common residual (mean of sign_j*h_j: the main loop's error, or
-    // the lag under acceleration) shows at every half period, reset or not;
-    // taken out per reset (sum of reset directions r_sum) so that only the
-    // reset's own phase error remains: the number of resets in a step
-    // correlates with the dither and the rate, and would bias the gain.
     let r_sum = n_plus + n_minus - (neg_p + neg_m) * pairs;
-    let common = (diff * r_sum) / n_half.max(1) as i32;
-    weighted - mean * w_sum - common
+    // S1: pair i's two halves (bit P-1-i) both sit at 2i + 1 - P, and
+    // r = carry - [negative] on both (a minus half's r is -w); the constant
+    // parts sum to zero over the step.
+    let s1 = (pairs - 1) * (n_plus + n_minus) - 2 * (plus.weighted + minus.weighted) as i32;
+    // 4*(first - second)*S1/n, rounded: the product (below 2^57) in 64 bits.
+    let slope = sums.first.wrapping_sub(sums.second) as i64 * s1 as i64;
+    let q = (n / 4) as i64;
+    let slope_share = (slope + q / 2).div_euclid(q) as i32;
+    weighted
+        .wrapping_mul(n)
+        .wrapping_sub(dc.wrapping_mul(w_sum))
+        .wrapping_sub(diff.wrapping_mul(r_sum))
+        .wrapping_add(slope_share)
 }
 
-/// Set bits of a carry mask of `pairs` bits. The M4 has no popcount
-/// instruction; up to 8 bits (16 half periods) two multiplies spread the bits
-/// into nibbles and sum them (Bit Twiddling Hacks), else the general count.
+/// Set bits of a carry mask and their bit-index moment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaskMoment {
+    /// Number of set bits.
+    pub count: u32,
+    /// Sum of the set bits' indices (bit 0 counts 0).
+    pub weighted: u32,
+}
+
+/// [`MaskMoment`] of the low `pairs` bits of `mask`. Up to 8 bits (16 half
+/// periods) one table lookup; up to 16 two; beyond, a loop.
 #[inline(always)]
-pub fn carry_count(mask: u32, pairs: i32) -> u32 {
+pub fn moment(mask: u32, pairs: i32) -> MaskMoment {
+    // Only the low `pairs` bits belong to the step.
+    let mask = mask
+        & u32::MAX
+            .checked_shr(32 - pairs.clamp(0, 32) as u32)
+            .unwrap_or(0);
+    let byte = |b: u32| BYTE_MOMENT[(b & 0xFF) as usize];
+    let unpack = |m: u16| MaskMoment {
+        count: (m >> 8) as u32,
+        weighted: (m & 0xFF) as u32,
+    };
     if pairs <= 8 {
-        let spread = ((mask & 0xFF).wrapping_mul(0x0804_0201) >> 3) & 0x1111_1111;
-        spread.wrapping_mul(0x1111_1111) >> 28
+        unpack(byte(mask))
+    } else if pairs <= 16 {
+        let (lo, hi) = (unpack(byte(mask)), unpack(byte(mask >> 8)));
+        MaskMoment {
+            count: lo.count + hi.count,
+            weighted: lo.weighted + hi.weighted + 8 * hi.count,
+        }
     } else {
-        mask.count_ones()
+        let mut m = MaskMoment {
+            count: 0,
+            weighted: 0,
+        };
+        for b in 0..pairs.min(32) as u32 {
+            let bit = (mask >> b) & 1;
+            m.count += bit;
+            m.weighted += b * bit;
+        }
+        m
     }
 }
 
+/// Per byte: set bits (high byte) and the sum of their indices (low byte, at
+/// most 28). 512 bytes of flash for a single load per mask in the interrupt.
+static BYTE_MOMENT: [u16; 256] = {
+    let mut t = [0u16; 256];
+    let mut v = 0;
+    while v < 256 {
+        let (mut count, mut weighted, mut b) = (0u16, 0u16, 0);
+        while b < 8 {
+            if (v >> b) & 1 == 1 {
+                count += 1;
+                weighted += b as u16;
+            }
+            b += 1;
+        }
+        t[v] = (count << 8) | weighted;
+        v += 1;
+    }
+    t
+};
+
 /// New digital gain (DAC codes per turn, Q8) after one step's reset error.
-/// `gain`: Q8 codes per unit normalised error (err/H), below 2^27;
-/// `recip_h`: 2^32 / H (H = DC of one half period's kept samples).
+/// `err`: [`reset_error`], n x ADC LSB; `gain`: Q8 codes per unit normalised
+/// error (err/(n*H)), Q4 (config folds the 1/n in), below 2^27;
+/// `recip_h`: 2^32 / H (H = DC of one half period's kept samples, at least 2,
+/// so below 2^31).
 #[inline(always)]
 pub fn update(cpt_q8: u32, err: i32, gain: i32, recip_h: u32, min: u32, max: u32) -> u32 {
-    // |err| <= 2^20 (beyond is not a gain error but a lost loop): one `ssat`.
-    let err = err.clamp(-(1 << 20), (1 << 20) - 1) as i64;
-    // err/H in Q24, saturated at |err/H| < 16 (a 25 % gain error, the
-    // clamp's end, gives a few units): only a wild start converges slower.
-    let e_q24 = super::shr_saturate::<8, 29>(err * recip_h as i64) as i64;
-    // Q24 x gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
-    let delta = ((e_q24 * gain as i64 + (1 << 23)) >> 24) as i32;
+    // err/H in Q20, saturated at |err/H| < 2^8 (n/16 times a 25 % gain error,
+    // the clamp's end): only a wild start converges slower.
+    let e_q20 = super::shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
+    // Q20 x Q4 gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
+    let delta = ((e_q20 * gain as i64 + (1 << 23)) >> 24) as i32;
     // cpt_q8, min, max < 2^24 (config); the subtraction saturates.
     (cpt_q8 as i32)
         .saturating_sub(delta)
