@@ -8,11 +8,17 @@ use gyro_sp::fog::FogParams;
 use host_tests::*;
 use std::f64::consts::PI;
 
+/// The 16-bit ADC's depth dither spans 240 codes (+-0.012 rad at 3pi/4, a
+/// quarter of the 12-bit default's +-0.05 rad). At 1 000 deg/s^2 the drift
+/// is a twentieth of an ADC code per step; the default 60 codes left a
+/// rounding artefact of -0.001 deg/h (-11 %) at 20 Hz, 240 codes leave none
+/// above the standard error.
 fn instrument(phi0: f64, closure: f64, correction: bool) -> FogParams {
     FogParams {
         phi0_rad: phi0,
         closure_hz: closure,
         vibration_correction: correction,
+        dither_adc_codes: 240.0,
         ..FogParams::default()
     }
 }
@@ -21,41 +27,102 @@ fn instrument(phi0: f64, closure: f64, correction: bool) -> FogParams {
 /// which sets the loop gain.
 const SETTLE: u64 = 5 * 4_096;
 
-/// (formula drift, raw drift, corrected drift) in deg/h.
-fn drift(phi0: f64, closure: f64, eps: f64, freq: f64) -> (f64, f64, f64) {
+/// The two reference instruments: (phi0, closure rate).
+const INSTRUMENTS: [(f64, f64); 2] = [(0.75 * PI, 12_500.0), (0.875 * PI, 6_250.0)];
+
+/// Formula drift and the measured drift (deg/h), the raw mean to a standard
+/// error of 0.5 % of the formula, or 15 simulated minutes (the 1 000 deg/s^2
+/// points stop there, near 1.5 %).
+fn drift(phi0: f64, closure: f64, eps: f64, freq: f64) -> (f64, Drift) {
     let mut r = rig(
         instrument(phi0, closure, true),
         |o| o.adc_bits = 16,
         vibration(eps, freq),
     );
-    let (a, b) = whole_periods(&r.cfg, freq, SETTLE, if eps < 5_000.0 { 10.0 } else { 2.0 });
     let formula = r.cfg.predicted_vibration_drift((eps * DEG).powi(2) / 2.0) * DPH;
-    let m = mean_error(&mut r, a, b);
-    (formula, m.raw_dph, m.corrected_dph)
+    let d = vibration_drift(&mut r, freq, SETTLE, 0.005 * formula.abs(), (2.0, 900.0));
+    println!(
+        "phi0 {phi0:.4} {closure} Hz closure, {freq} Hz, eps {eps}: formula {formula:.5} raw {:.5} +- {:.5} ({:+.2} %) corrected {:.5} ({:+.2} %) deg/h over {:.0} s",
+        d.raw_dph,
+        d.raw_se_dph,
+        (d.raw_dph / formula - 1.0) * 100.0,
+        d.corrected_dph,
+        d.corrected_dph / formula * 100.0,
+        d.seconds
+    );
+    assert!(
+        d.raw_se_dph < 0.02 * formula.abs(),
+        "eps {eps}: standard error {} too large to test 5 %",
+        d.raw_se_dph
+    );
+    (formula, d)
 }
 
-/// Both reference instruments at 20 000 and 50 000 deg/s^2, 60 Hz: drift
-/// within 5 % of the formula, at least 95 % of it removed. (The 7pi/8,
-/// 6.25 kHz instrument read 17 % high before the DC filter learned to discount
-/// the residual's spread.)
+/// Both reference instruments over 1 000 .. 50 000 deg/s^2 at 60 Hz: the
+/// drift within 5 % of the formula, at least 95 % of it removed by the
+/// correction. Each point is averaged until its standard error is small
+/// against 5 % (3pi/4 at 1 000 deg/s^2 averages 15 minutes).
 #[test]
-fn drift_matches_formula_at_high_acceleration() {
-    for (phi0, closure) in [(0.75 * PI, 12_500.0), (0.875 * PI, 6_250.0)] {
-        for eps in [20_000.0, 50_000.0] {
-            let (f, raw, corr) = drift(phi0, closure, eps, 60.0);
-            println!(
-                "phi0 {phi0:.4} eps {eps}: formula {f:.5} raw {raw:.5} corrected {corr:.5} deg/h"
-            );
-            assert!(
-                (raw / f - 1.0).abs() < 0.05,
-                "phi0 {phi0:.3} eps {eps}: drift {raw} vs formula {f}"
-            );
-            assert!(
-                corr.abs() < 0.05 * f,
-                "phi0 {phi0:.3} eps {eps}: corrected {corr} of {f}"
-            );
+fn drift_matches_formula_and_correction_removes_it() {
+    let mut failures = Vec::new();
+    for (phi0, closure) in INSTRUMENTS {
+        for eps in [1_000.0, 5_000.0, 20_000.0, 50_000.0] {
+            let (f, d) = drift(phi0, closure, eps, 60.0);
+            if (d.raw_dph / f - 1.0).abs() > 0.05 {
+                failures.push(format!(
+                    "phi0 {phi0:.3} eps {eps}: drift {:.5} vs formula {f:.5}",
+                    d.raw_dph
+                ));
+            }
+            if d.corrected_dph.abs() > 0.05 * f {
+                failures.push(format!(
+                    "phi0 {phi0:.3} eps {eps}: corrected {:.5} of {f:.5}",
+                    d.corrected_dph
+                ));
+            }
         }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The correction at 20 Hz and 200 Hz still removes at least 95 % of the
+/// drift: both instruments at 1 000 .. 50 000 deg/s^2, except 7pi/8 at
+/// 200 Hz and 50 000 deg/s^2 (see the ignored test below). At 200 Hz a
+/// one-step lag would leave 2 % (cos(w*dt_p) at 6.25 kHz); the predicted
+/// residual removes it.
+#[test]
+fn correction_works_at_20_and_200_hz() {
+    let mut failures = Vec::new();
+    for freq in [20.0, 200.0] {
+        for (phi0, closure) in INSTRUMENTS {
+            let top = if freq > 100.0 && phi0 > 0.8 * PI {
+                20_000.0
+            } else {
+                50_000.0
+            };
+            for eps in [1_000.0, 5_000.0, top] {
+                let (f, d) = drift(phi0, closure, eps, freq);
+                if d.corrected_dph.abs() > 0.05 * f {
+                    failures.push(format!(
+                        "{freq} Hz phi0 {phi0:.3} eps {eps}: corrected {:.5} of {f:.5}",
+                        d.corrected_dph
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+#[ignore = "known gap: 7pi/8 at 200 Hz and 50 000 deg/s^2 the second-order correction leaves 5.2 % of the drift; a float model of the same loop without quantisation leaves 4.1 % (fourth-order terms of the cosine and the loop's dynamics at w*dt_p = 0.2), so this needs a higher-order correction term"]
+fn correction_at_200_hz_near_dark_fringe_at_50_000() {
+    let (f, d) = drift(0.875 * PI, 6_250.0, 50_000.0, 200.0);
+    assert!(
+        d.corrected_dph.abs() < 0.05 * f,
+        "corrected {} of {f}",
+        d.corrected_dph
+    );
 }
 
 /// Near the dark fringe (7pi/8) the residual's spread under vibration raises
@@ -88,47 +155,6 @@ fn loop_gain_holds_under_vibration_near_dark_fringe() {
     let gain = md / dd;
     println!("measured/true residual gain {gain:.4}");
     assert!((gain - 1.0).abs() < 0.025, "residual gain {gain}");
-}
-
-#[test]
-#[ignore = "known gap: 1 000 deg/s^2 (both instruments) and 7pi/8 at 5 000 carry a second rectified error (-0.003 / -0.02..-0.07 deg/h): the 2*pi loop settles 15-33 ppm off under vibration and reset errors rectify; with the 2*pi loop held 3pi/4 matches within 3 % (7pi/8 still 32 % low); see README status"]
-fn drift_matches_formula_and_correction_removes_it() {
-    let mut failures = Vec::new();
-    for (phi0, closure) in [(0.75 * PI, 12_500.0), (0.875 * PI, 6_250.0)] {
-        for eps in [1_000.0, 5_000.0, 20_000.0, 50_000.0] {
-            let (f, raw, corr) = drift(phi0, closure, eps, 60.0);
-            println!("phi0 {phi0:.4} closure {closure} eps {eps}: formula {f:.5} raw {raw:.5} corrected {corr:.5} deg/h");
-            if (raw / f - 1.0).abs() > 0.05 {
-                failures.push(format!(
-                    "phi0 {phi0:.3} {closure} Hz eps {eps}: drift {raw:.5} vs formula {f:.5}"
-                ));
-            }
-            if corr.abs() > 0.05 * f.abs() {
-                failures.push(format!(
-                    "phi0 {phi0:.3} {closure} Hz eps {eps}: corrected {corr:.5} of {f:.5}"
-                ));
-            }
-        }
-    }
-    assert!(failures.is_empty(), "{failures:#?}");
-}
-
-#[test]
-#[ignore = "known gap: at 200 Hz, 5 000 deg/s^2 the uncorrected output reads 19 % low (the rectified 2*pi-reset error, see README status), so the correction leaves 22 % of the raw drift; 20 Hz and 50 000 deg/s^2 pass"]
-fn correction_works_at_20_and_200_hz() {
-    let mut failures = Vec::new();
-    for freq in [20.0, 200.0] {
-        for eps in [5_000.0, 50_000.0] {
-            let (f, raw, corr) = drift(0.75 * PI, 12_500.0, eps, freq);
-            println!("{freq} Hz eps {eps}: formula {f:.5} raw {raw:.5} corrected {corr:.5} deg/h");
-            if corr.abs() > 0.05 * raw.abs() {
-                failures.push(format!(
-                    "{freq} Hz eps {eps}: corrected {corr:.5} of raw {raw:.5}"
-                ));
-            }
-        }
-    }
-    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// With noise and no vibration the correction's mean is zero: it is built from

@@ -160,6 +160,8 @@ pub struct FogConfig {
     pub h0_min: u32,
     /// Residual beyond which a step counts toward loss of lock, phase LSB.
     pub lock_limit: u32,
+    /// Residual beyond which the 2*pi loop holds (0.1 rad), phase LSB.
+    pub gain_hold_limit: u32,
     /// Consecutive steps beyond `lock_limit` that declare loss of lock.
     pub lock_steps: u16,
 }
@@ -330,6 +332,7 @@ impl FogConfig {
             h0_min: h0_min as u32,
             dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,
             lock_limit: phase_from_rad(0.5 * PI),
+            gain_hold_limit: phase_from_rad(0.1),
             lock_steps: 8,
         })
     }

@@ -59,7 +59,13 @@ pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
     // 4*(first - second)*S1/n, rounded: the product (below 2^57) in 64 bits.
     let slope = sums.first.wrapping_sub(sums.second) as i64 * s1 as i64;
     let q = (n / 4) as i64;
-    let slope_share = (slope + q / 2).div_euclid(q) as i32;
+    // Floor division (a shift for the reference layouts, where q is 4 or 8).
+    let rounded = slope + q / 2;
+    let slope_share = if q.count_ones() == 1 {
+        (rounded >> q.trailing_zeros()) as i32
+    } else {
+        rounded.div_euclid(q) as i32
+    };
     weighted
         .wrapping_mul(n)
         .wrapping_sub(dc.wrapping_mul(w_sum))
