@@ -49,7 +49,7 @@ pub struct FogLoop {
     modulator: Modulator,
     /// Where the DAC words now being applied reset (used in the next call).
     carries: Carries,
-    /// Their depth dither's gain factor less one, Q32 (see `next_dither`).
+    /// Their depth dither's gain factor less one, Q32 (see `write_next`).
     dither_fm1_q32: i32,
     vibration: VibrationCorrection,
     unlocked_steps: u16,
@@ -115,9 +115,10 @@ impl FogLoop {
         x ^= x >> 17;
         x ^= x << 5;
         self.dither = x;
-        let r = (x as i32).checked_shr(32 - cfg.dither_bits).unwrap_or(0); // bits = 0: off
-                                                                           // 1 - r*cot(phi0) less one, Q32, from x = r * 2^(32 - bits) (the
-                                                                           // dropped low bits are under 2^-bits of it).
+        // bits = 0: off.
+        let r = (x as i32).checked_shr(32 - cfg.dither_bits).unwrap_or(0);
+        // 1 - r*cot(phi0) less one, Q32, from x = r * 2^(32 - bits) (the
+        // dropped low bits are under 2^-bits of it).
         self.dither_fm1_q32 = ((x as i32 as i64 * cfg.dither_gain as i64) >> 32) as i32;
         self.carries = self.modulator.write_step(
             self.step as u32,
@@ -227,12 +228,12 @@ impl FogLoop {
             if adc_over_range {
                 self.vibration.reset();
             } else {
-                let err = gain_loop::reset_error(&sums, &self.carries, n_half as u32);
                 // Under strong dynamics the step's DC carries the residual's
                 // delta^2 (22 % of it at 0.19 rad near the dark fringe),
                 // far more than a reset's 2*pi*g: the 2*pi loop holds while
                 // |residual| > gain_hold_limit (V_pi drifts slowly).
                 if residual.unsigned_abs() <= cfg.gain_hold_limit {
+                    let err = gain_loop::reset_error(&sums, &self.carries, n_half as u32);
                     self.cpt_q8 = gain_loop::update(
                         self.cpt_q8,
                         err,

@@ -257,8 +257,8 @@ impl FogConfig {
         // dither of half width w the mean slope is A*sin(phi0)*G, G = <cos r> -
         // cot^2(phi0)*<r sin r> = sin(w)/w - cot^2(phi0)*(sin w - w cos w)/w,
         // and the DC A*(1 + c*sin(w)/w) (c = cos phi0), so the unit-gain scale
-        // is cot(phi0/2)/n times (1 + c*sin(w)/w)/((1 + c)*G): +1.7 % at 7pi/8
-        // with the 12-bit ADC's dither. (The residual's own spread moves the
+        // is cot(phi0/2)/n times (1 + c*sin(w)/w)/((1 + c)*G): +0.25 % at
+        // 7pi/8 with the 12-bit ADC's dither (w = 0.025 rad). (The residual's own spread moves the
         // DC the same way; the closure measures that per step.)
         let c = p.phi0_rad.cos();
         let w = if dither_bits > 0 {
