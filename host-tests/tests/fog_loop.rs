@@ -1,8 +1,19 @@
 //! Closed loop on the simulated photodetector: lock, linearity, steps, 2*pi loop, faults.
+//! Lock, steps and the 2*pi loop are checked for both DAC pipelines: words
+//! applied the next step (QEMU, host) and the step after next (the hw DMA
+//! ping-pong, `dac_latency_steps = 1`).
 
 use gyro_sp::fog::{Faults, FogParams};
 use gyro_sp::sim::{Profile, Segment};
 use host_tests::*;
+
+/// The default instrument with `latency` steps of DAC latency.
+fn with_latency(latency: u32) -> FogParams {
+    FogParams {
+        dac_latency_steps: latency,
+        ..FogParams::default()
+    }
+}
 
 #[test]
 fn holds_lock_at_500_dps() {
@@ -17,27 +28,31 @@ fn holds_lock_at_500_dps() {
             duration: f64::INFINITY,
         },
     ]);
-    let mut r = rig(FogParams::default(), |_| {}, p);
-    let m = mean_error(&mut r, 6_000, 18_500);
-    // 10 ppm of 500 deg/s is 18 deg/h: locked on the right fringe.
-    assert!(
-        m.corrected_dph.abs() < 18.0,
-        "error at 500 deg/s: {} deg/h",
-        m.corrected_dph
-    );
-    assert_eq!(m.faults_seen & Faults::OUT_OF_LOCK, 0);
+    for latency in [0, 1] {
+        let mut r = rig(with_latency(latency), |_| {}, p.clone());
+        let m = mean_error(&mut r, 6_000, 18_500);
+        // 10 ppm of 500 deg/s is 18 deg/h: locked on the right fringe.
+        assert!(
+            m.corrected_dph.abs() < 18.0,
+            "latency {latency}: error at 500 deg/s: {} deg/h",
+            m.corrected_dph
+        );
+        assert_eq!(m.faults_seen & Faults::OUT_OF_LOCK, 0);
+    }
 }
 
 #[test]
 fn locks_from_rest() {
-    let mut r = rig(FogParams::default(), |_| {}, Profile::constant(0.0));
-    let m = mean_error(&mut r, 100, 12_500);
-    assert!(
-        m.corrected_dph.abs() < 0.01,
-        "bias at rest {} deg/h",
-        m.corrected_dph
-    );
-    assert_eq!(m.faults_seen, 0);
+    for latency in [0, 1] {
+        let mut r = rig(with_latency(latency), |_| {}, Profile::constant(0.0));
+        let m = mean_error(&mut r, 100, 12_500);
+        assert!(
+            m.corrected_dph.abs() < 0.01,
+            "latency {latency}: bias at rest {} deg/h",
+            m.corrected_dph
+        );
+        assert_eq!(m.faults_seen, 0);
+    }
 }
 
 /// Reaches +-50 .. +-500 deg/s on a 2000 deg/s^2 table ramp and holds lock
@@ -101,8 +116,16 @@ fn scale_factor_linear_within_1ppm_to_500dps() {
 /// A rate step settles within a few closure steps: the unit-gain loop is
 /// dead-beat on a linear error; the cosine compresses a large first residual
 /// (1.9 rad at 80 deg/s) so the first correction falls short by a few per cent.
+/// With one step of DAC latency the Smith predictor keeps the dead-beat
+/// response, each correction one step later.
 #[test]
 fn rate_step_tracked_within_settling_time() {
+    for latency in [0, 1] {
+        rate_step(latency);
+    }
+}
+
+fn rate_step(latency: u32) {
     let p = Profile::new(&[
         Segment::Constant {
             rate: 0.0,
@@ -113,21 +136,26 @@ fn rate_step_tracked_within_settling_time() {
             duration: f64::INFINITY,
         },
     ]);
-    let mut r = rig(FogParams::default(), |_| {}, p);
+    let mut r = rig(with_latency(latency), |_| {}, p);
     let lsb = r.cfg.rad_s_per_step_lsb();
     let step_at = (0.01 * 12_500.0) as u64;
     let mut errs = Vec::new();
-    while r.step_index() < step_at + 10 {
+    while r.step_index() < step_at + 20 {
         let s = r.step();
         if r.step_index() > step_at {
             errs.push((s.out.step as f64 * lsb - s.true_rate) / (80.0 * DEG));
         }
     }
-    // From the seventh step (560 us) on the error is below 1e-3 of the step.
-    for (k, e) in errs.iter().enumerate().skip(6) {
+    // From the seventh step (560 us) on the error is below 1e-3 of the step
+    // (it is from the fourth). With latency each correction shows a step
+    // later, so each error of the latency-free response lasts two steps (the
+    // simulation gives the same sequence with every value twice): from the
+    // thirteenth.
+    let settled = 6 * (1 + latency as usize);
+    for (k, e) in errs.iter().enumerate().skip(settled) {
         assert!(
             e.abs() < 1e-3,
-            "step {k} after the input step: relative error {e:e}"
+            "latency {latency}: step {k} after the input step: relative error {e:e}"
         );
     }
 }
@@ -135,9 +163,9 @@ fn rate_step_tracked_within_settling_time() {
 /// V_pi 5 % off: the 2*pi loop trims the digital gain to 1/1.05 of nominal.
 #[test]
 fn two_pi_loop_converges_from_5_percent_vpi_error() {
-    for err in [0.05, -0.05] {
+    for (err, latency) in [(0.05, 0), (-0.05, 0), (0.05, 1), (-0.05, 1)] {
         let mut r = rig(
-            FogParams::default(),
+            with_latency(latency),
             |o| o.vpi_gain_error = err,
             Profile::constant(100.0 * DEG),
         );
@@ -146,12 +174,12 @@ fn two_pi_loop_converges_from_5_percent_vpi_error() {
         let expected = 49_152.0 / (1.0 + err);
         assert!(
             (cpt / expected - 1.0).abs() < 1e-4,
-            "V_pi error {err}: codes per turn {cpt}, expected {expected}"
+            "V_pi error {err}, latency {latency}: codes per turn {cpt}, expected {expected}"
         );
         let late = mean_error(&mut r, 12_500, 25_000);
         assert!(
             late.corrected_dph.abs() < 0.5,
-            "V_pi error {err}: bias {} deg/h after convergence",
+            "V_pi error {err}, latency {latency}: bias {} deg/h after convergence",
             late.corrected_dph
         );
     }

@@ -34,11 +34,12 @@ const INSTRUMENTS: [(f64, f64); 2] = [(0.75 * PI, 12_500.0), (0.875 * PI, 6_250.
 /// error of 0.5 % of the formula, or 15 simulated minutes (the 1 000 deg/s^2
 /// points stop there, near 1.5 %).
 fn drift(phi0: f64, closure: f64, eps: f64, freq: f64) -> (f64, Drift) {
-    let mut r = rig(
-        instrument(phi0, closure, true),
-        |o| o.adc_bits = 16,
-        vibration(eps, freq),
-    );
+    drift_of(instrument(phi0, closure, true), eps, freq)
+}
+
+fn drift_of(params: FogParams, eps: f64, freq: f64) -> (f64, Drift) {
+    let (phi0, closure) = (params.phi0_rad, params.closure_hz);
+    let mut r = rig(params, |o| o.adc_bits = 16, vibration(eps, freq));
     let formula = r.cfg.predicted_vibration_drift((eps * DEG).powi(2) / 2.0) * DPH;
     let d = vibration_drift(&mut r, freq, SETTLE, 0.005 * formula.abs(), (2.0, 900.0));
     println!(
@@ -86,21 +87,15 @@ fn drift_matches_formula_and_correction_removes_it() {
 }
 
 /// The correction at 20 Hz and 200 Hz still removes at least 95 % of the
-/// drift: both instruments at 1 000 .. 50 000 deg/s^2, except 7pi/8 at
-/// 200 Hz and 50 000 deg/s^2 (see the ignored test below). At 200 Hz a
-/// one-step lag would leave 2 % (cos(w*dt_p) at 6.25 kHz); the predicted
-/// residual removes it.
+/// drift: both instruments at 1 000, 5 000 and 50 000 deg/s^2. It inverts
+/// each step's own measurement, so the loop's lag at 200 Hz (w*dt_p = 0.2 at
+/// 6.25 kHz) does not enter.
 #[test]
 fn correction_works_at_20_and_200_hz() {
     let mut failures = Vec::new();
     for freq in [20.0, 200.0] {
         for (phi0, closure) in INSTRUMENTS {
-            let top = if freq > 100.0 && phi0 > 0.8 * PI {
-                20_000.0
-            } else {
-                50_000.0
-            };
-            for eps in [1_000.0, 5_000.0, top] {
+            for eps in [1_000.0, 5_000.0, 50_000.0] {
                 let (f, d) = drift(phi0, closure, eps, freq);
                 if d.corrected_dph.abs() > 0.05 * f {
                     failures.push(format!(
@@ -114,15 +109,44 @@ fn correction_works_at_20_and_200_hz() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// The hw board's DMA ping-pong applies the words one step later
+/// (`dac_latency_steps = 1`). The loop then lags a rate ramp by 1/g + 1 steps
+/// instead of 1/g, so the drift doubles at unit gain
+/// (`FogConfig::predicted_vibration_drift`); the correction, which inverts
+/// each step's own measurement, needs no change. Both instruments, 60 Hz and
+/// 200 Hz, 5 000 deg/s^2 up to 50 000 (3pi/4) or 20 000 (7pi/8): the drift
+/// within 5 % of the derived formula at 60 Hz, at least 95 % of it removed.
+/// Not at 7pi/8 and 50 000 deg/s^2: the doubled residual reaches 0.40 rad,
+/// where the AGC's second-order model of the residual's DC (from the
+/// compressed measured residual) sets the loop gain 4.6 % low (0.992 without
+/// latency): measured drift +9.5 % off the formula, 9.0 % left by the
+/// correction. The hw build runs 3pi/4 at 12.5 kHz.
 #[test]
-#[ignore = "known gap: 7pi/8 at 200 Hz and 50 000 deg/s^2 the second-order correction leaves 5.2 % of the drift; a float model of the same loop without quantisation leaves 4.1 % (fourth-order terms of the cosine and the loop's dynamics at w*dt_p = 0.2), so this needs a higher-order correction term"]
-fn correction_at_200_hz_near_dark_fringe_at_50_000() {
-    let (f, d) = drift(0.875 * PI, 6_250.0, 50_000.0, 200.0);
-    assert!(
-        d.corrected_dph.abs() < 0.05 * f,
-        "corrected {} of {f}",
-        d.corrected_dph
-    );
+fn dac_latency_doubles_the_drift_and_the_correction_removes_it() {
+    let mut failures = Vec::new();
+    for (phi0, closure) in INSTRUMENTS {
+        let top = if phi0 > 0.8 * PI { 20_000.0 } else { 50_000.0 };
+        for (freq, eps) in [(60.0, 5_000.0), (60.0, top), (200.0, top)] {
+            let params = FogParams {
+                dac_latency_steps: 1,
+                ..instrument(phi0, closure, true)
+            };
+            let (f, d) = drift_of(params, eps, freq);
+            if freq < 100.0 && (d.raw_dph / f - 1.0).abs() > 0.05 {
+                failures.push(format!(
+                    "phi0 {phi0:.3} eps {eps}: drift {:.5} vs formula {f:.5}",
+                    d.raw_dph
+                ));
+            }
+            if d.corrected_dph.abs() > 0.05 * f {
+                failures.push(format!(
+                    "{freq} Hz phi0 {phi0:.3} eps {eps}: corrected {:.5} of {f:.5}",
+                    d.corrected_dph
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// Near the dark fringe (7pi/8) the residual's spread under vibration raises
@@ -157,8 +181,9 @@ fn loop_gain_holds_under_vibration_near_dark_fringe() {
     assert!((gain - 1.0).abs() < 0.025, "residual gain {gain}");
 }
 
-/// With noise and no vibration the correction's mean is zero: it is built from
-/// the product of two slope estimates with disjoint noise.
+/// With noise and no vibration the correction's mean is zero: the step's
+/// residual and slope share samples, but the two halves' noise has the same
+/// statistics, so their product has no mean.
 #[test]
 fn correction_adds_no_drift_at_rest_with_noise() {
     for seed in [1, 2] {

@@ -2,10 +2,11 @@
 //!
 //! Batch processing as in quartiq's stabilizer: the interrupt hands over the ADC
 //! samples of step k (taken while the DAC words of step k were applied) and gets
-//! back the DAC words of step k+1. The immutable [`FogConfig`] is passed in; all
+//! back the DAC words of step k+1, or with one step of DAC latency (the hw
+//! DMA ping-pong) of step k+2. The immutable [`FogConfig`] is passed in; all
 //! mutable state lives in [`FogLoop`].
 
-use super::config::FogConfig;
+use super::config::{FogConfig, Kernel};
 use super::demod::demodulate;
 use super::faults::Faults;
 use super::gain_loop;
@@ -31,10 +32,22 @@ pub struct ClosureOutput {
     pub faults: Faults,
 }
 
+/// What the closure needs to know about DAC words when their samples come back.
+#[derive(Clone, Copy, Debug, Default)]
+struct Written {
+    /// Where the words reset (for the 2*pi loop).
+    carries: Carries,
+    /// Their depth dither's gain factor less one, Q32 (see `write_next`).
+    dither_fm1_q32: i32,
+    /// The feedback step they carry, phase LSB. Kept only with DAC latency;
+    /// without, it is [`FogLoop::step`].
+    step: i64,
+}
+
 /// Mutable state of one FOG channel.
 #[derive(Clone, Copy, Debug)]
 pub struct FogLoop {
-    /// Integrator: feedback step, phase LSB, unwrapped.
+    /// Integrator: the feedback step last written, phase LSB, unwrapped.
     step: i64,
     /// Digital gain, DAC codes per turn in Q8.
     cpt_q8: u32,
@@ -47,10 +60,11 @@ pub struct FogLoop {
     /// The DC filter holds a measured value (seeded on the first good step).
     dc_valid: bool,
     modulator: Modulator,
-    /// Where the DAC words now being applied reset (used in the next call).
-    carries: Carries,
-    /// Their depth dither's gain factor less one, Q32 (see `write_next`).
-    dither_fm1_q32: i32,
+    /// The DAC words the next call's samples were taken with.
+    applied: Written,
+    /// With one step of DAC latency: the words written last call, applied
+    /// after `applied`.
+    in_flight: Written,
     vibration: VibrationCorrection,
     unlocked_steps: u16,
     faults: Faults,
@@ -87,8 +101,8 @@ impl FogLoop {
             dc_q12: cfg.h0_nominal.min(MAX_HALF_SUM) << 12,
             dc_valid: false,
             modulator: Modulator::default(),
-            carries: Carries::default(),
-            dither_fm1_q32: 0,
+            applied: Written::default(),
+            in_flight: Written::default(),
             vibration: VibrationCorrection::default(),
             unlocked_steps: 0,
             faults: Faults::default(),
@@ -96,10 +110,17 @@ impl FogLoop {
         }
     }
 
-    /// Writes the first step's DAC words (before any ADC data exists).
+    /// Writes the first step's DAC words (before any ADC data exists). With
+    /// one step of DAC latency the caller copies them into the other buffer
+    /// too: both are applied before the first new words.
     pub fn start(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
         if let Some(dac) = dac.get_mut(..cfg.n_half) {
-            self.write_next(cfg, dac);
+            if cfg.params.dac_latency_steps == 0 {
+                self.write_next::<0>(cfg, dac);
+            } else {
+                self.write_next::<1>(cfg, dac);
+                self.applied = self.in_flight;
+            }
         }
     }
 
@@ -107,9 +128,9 @@ impl FogLoop {
     /// uniform in [-2^(dither_bits-1), 2^(dither_bits-1)) phase LSB
     /// (xorshift32; a golden-ratio sequence was tried and its lines beat with
     /// the reset pattern at some rates), and keeps r's gain factor for the
-    /// step that will demodulate these words.
+    /// step that will demodulate these words, `LATENCY` calls later.
     #[inline(always)]
-    fn write_next(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
+    fn write_next<const LATENCY: usize>(&mut self, cfg: &FogConfig, dac: &mut [u16]) {
         let mut x = self.dither;
         x ^= x << 13;
         x ^= x >> 17;
@@ -119,19 +140,32 @@ impl FogLoop {
         let r = (x as i32).checked_shr(32 - cfg.dither_bits).unwrap_or(0);
         // 1 - r*cot(phi0) less one, Q32, from x = r * 2^(32 - bits) (the
         // dropped low bits are under 2^-bits of it).
-        self.dither_fm1_q32 = ((x as i32 as i64 * cfg.dither_gain as i64) >> 32) as i32;
-        self.carries = self.modulator.write_step(
+        let dither_fm1_q32 = ((x as i32 as i64 * cfg.dither_gain as i64) >> 32) as i32;
+        let carries = self.modulator.write_step(
             self.step as u32,
             cfg.phi0.wrapping_add_signed(r),
             self.cpt_q8,
             dac,
         );
+        if LATENCY == 0 {
+            self.applied.carries = carries;
+            self.applied.dither_fm1_q32 = dither_fm1_q32;
+        } else {
+            self.applied = self.in_flight;
+            self.in_flight = Written {
+                carries,
+                dither_fm1_q32,
+                step: self.step,
+            };
+        }
     }
 
     /// One closure step. `adc`: `cfg.n_samples` samples of the step just applied;
     /// `adc_over_range`: the ADC's analog watchdog fired during them;
     /// `dac`: receives `cfg.n_half` words for the next step. Never panics: short
-    /// buffers are treated as a lost (held) step.
+    /// buffers are treated as a lost (held) step. Inlined so the interrupt
+    /// (and the rig's `process_core`) holds the step without a call.
+    #[inline(always)]
     pub fn process(
         &mut self,
         cfg: &FogConfig,
@@ -139,21 +173,19 @@ impl FogLoop {
         adc_over_range: bool,
         dac: &mut [u16],
     ) -> ClosureOutput {
-        // The reference instruments' layouts get a copy of the step with the
-        // sizes as constants (divisions become shifts, loops unroll); any
-        // other layout runs the same code with runtime sizes.
         let layout = (cfg.n_half, cfg.samples_per_half, cfg.skip_samples);
-        match layout {
-            (16, 4, 1) => self.step_with((16, 4, 1), cfg, adc, adc_over_range, dac),
-            (32, 4, 1) => self.step_with((32, 4, 1), cfg, adc, adc_over_range, dac),
-            _ => self.step_with(layout, cfg, adc, adc_over_range, dac),
+        match cfg.kernel {
+            Kernel::Half16 => self.step_with::<0>((16, 4, 1), cfg, adc, adc_over_range, dac),
+            Kernel::Half32 => self.step_with::<0>((32, 4, 1), cfg, adc, adc_over_range, dac),
+            Kernel::Any => self.step_with::<0>(layout, cfg, adc, adc_over_range, dac),
+            Kernel::AnyLatency1 => self.step_with::<1>(layout, cfg, adc, adc_over_range, dac),
         }
     }
 
     /// [`Self::process`] for `(n_half, samples_per_half, skip)` = `layout`
-    /// (equal to the config's).
+    /// and DAC latency `LATENCY` (equal to the config's).
     #[inline(always)]
-    fn step_with(
+    fn step_with<const LATENCY: usize>(
         &mut self,
         (n_half, samples_per_half, skip): (usize, usize, usize),
         cfg: &FogConfig,
@@ -166,7 +198,13 @@ impl FogLoop {
             self.faults.set(Faults::ADC_SATURATION, true);
             return self.output(self.step, 0, 0, 0);
         };
-        let sums = demodulate(adc, samples_per_half, skip, n_half, &self.carries);
+        // The feedback step these samples were taken with.
+        let applied_step = if LATENCY == 0 {
+            self.step
+        } else {
+            self.applied.step
+        };
+        let sums = demodulate(adc, samples_per_half, skip, n_half, &self.applied.carries);
         // Detector DC of one half period, ADC dark level removed (per-half sum).
         let h_step = (sums.dc / n_half as u32).saturating_sub(cfg.dark_half);
         let power_low = h_step < cfg.h0_min;
@@ -174,14 +212,13 @@ impl FogLoop {
         self.faults.set(Faults::ADC_SATURATION, adc_over_range);
 
         let mut residual = 0i32;
-        let mut bias = 0i64;
+        let mut bias = 0i32;
         // Sagnac phase measured over this step: applied step plus residual.
-        let mut measured = self.step;
+        let mut measured = applied_step;
         if power_low {
             // Safe path: the error means nothing without light. Hold the step and
-            // the gain; the output repeats the last good step (flagged); AGC and
-            // the correction restart when the light comes back.
-            self.vibration.reset();
+            // the gain; the output repeats the last good step (flagged); the AGC
+            // restarts when the light comes back.
             self.dc_valid = false;
         } else {
             // Slow AGC: normalise by a low-passed DC so the loop gain does not depend
@@ -206,7 +243,7 @@ impl FogLoop {
             // residual under vibration. Config bounds k_meas/h0_min times the
             // factor so that kn < 2^31; the factor is one `smmla`.
             let kn = ((cfg.k_meas as u64 * recip_h as u64) >> 16) as i32;
-            let kn = kn + ((kn as i64 * self.dither_fm1_q32 as i64) >> 32) as i32;
+            let kn = kn + ((kn as i64 * self.applied.dither_fm1_q32 as i64) >> 32) as i32;
             // Kept sums < 2^20 per half, at most 64 halves: |sum|, |diff| < 2^26;
             // kn < 2^31: both products below 2^57. The residual
             // saturates at +-half a turn: the error is periodic, so an estimate
@@ -221,19 +258,28 @@ impl FogLoop {
             // Clipped samples still give the error's sign, so the main loop keeps
             // running through over-range (holding it could lock it there); the
             // gain loop and the correction, which need true levels, pause.
-            measured = self.step + residual as i64;
-            // |residual| < 2^31, gain < 2^17 (Q16 below 2): one 32x32 product.
-            let correction = (residual as i64 * cfg.loop_gain_q16 as i64) >> 16;
-            self.step = clamp_step(self.step + correction);
-            if adc_over_range {
-                self.vibration.reset();
+            measured = applied_step + residual as i64;
+            let correction = if LATENCY == 0 {
+                // |residual| < 2^31, gain < 2^17 (Q16 below 2): one 32x32 product.
+                (residual as i64 * cfg.loop_gain_q16 as i64) >> 16
             } else {
+                // The words in flight already carry a step this measurement
+                // has not seen: integrating the residual alone would count
+                // it twice (unit gain then sits on the stability limit,
+                // z^2 - z + 1). Correcting toward the measured phase from
+                // the last step written (a Smith predictor for the pure
+                // delay) keeps the latency-free loop's dynamics, delayed by
+                // one step. |measured - step| < 2^42: the product < 2^59.
+                ((measured - self.step) * cfg.loop_gain_q16 as i64) >> 16
+            };
+            self.step = clamp_step(self.step + correction);
+            if !adc_over_range {
                 // Under strong dynamics the step's DC carries the residual's
                 // delta^2 (22 % of it at 0.19 rad near the dark fringe),
                 // far more than a reset's 2*pi*g: the 2*pi loop holds while
                 // |residual| > gain_hold_limit (V_pi drifts slowly).
                 if residual.unsigned_abs() <= cfg.gain_hold_limit {
-                    let err = gain_loop::reset_error(&sums, &self.carries, n_half as u32);
+                    let err = gain_loop::reset_error(&sums, &self.applied.carries, n_half as u32);
                     self.cpt_q8 = gain_loop::update(
                         self.cpt_q8,
                         err,
@@ -276,14 +322,14 @@ impl FogLoop {
         }
         // The DAC words first: written straight from registers (built
         // after the output, they were spilled to the stack).
-        self.write_next(cfg, dac);
+        self.write_next::<LATENCY>(cfg, dac);
         self.output(measured, residual, bias, h_step)
     }
 
-    fn output(&self, measured: i64, residual: i32, bias: i64, dc: u32) -> ClosureOutput {
+    fn output(&self, measured: i64, residual: i32, bias: i32, dc: u32) -> ClosureOutput {
         ClosureOutput {
             step: measured,
-            step_corrected: measured - bias,
+            step_corrected: measured - bias as i64,
             residual,
             codes_per_turn_q8: self.cpt_q8,
             dc,

@@ -32,6 +32,12 @@ pub struct FogParams {
     pub skip_samples: usize,
     /// Main-loop gain: fraction of the measured residual corrected per step.
     pub loop_gain: f64,
+    /// Steps between the closure writing DAC words and the ADC sampling them,
+    /// beyond the next step: 0 when the words written now are applied next
+    /// step (QEMU, host rigs), 1 for the hw board's DMA ping-pong (the
+    /// interrupt writes the buffer half the DMA has just left, applied the
+    /// step after next). At most 1.
+    pub dac_latency_steps: u32,
     /// 2*pi gain-loop gain: fraction of a measured gain error corrected per reset.
     pub gain_loop_gain: f64,
     /// DAC codes that give 2*pi at the modulator at nominal V_pi.
@@ -69,6 +75,7 @@ impl Default for FogParams {
             samples_per_half: 4,
             skip_samples: 1,
             loop_gain: 1.0,
+            dac_latency_steps: 0,
             gain_loop_gain: 0.05,
             dac_codes_per_turn: 49_152,
             dither_adc_codes: 60.0,
@@ -93,13 +100,31 @@ pub enum ConfigError {
     Samples,
     /// phi0 outside [0.1, pi - 0.1] rad.
     Phi0,
-    /// Loop gain outside (0, 2) (the one-step integrator is unstable beyond).
+    /// Loop gain outside (0, 2) (the one-step integrator is unstable beyond),
+    /// or DAC latency above one step.
     LoopGain,
     /// DAC codes per turn leave no headroom for the 2*pi loop in 16 bits.
     DacRange,
+    /// The epsilon-squared correction's coefficient |cot(phi0)|/n_half is 0.637
+    /// or more (phi0 within 0.37 rad of 0 or pi at 4 half periods per step,
+    /// within 0.19 rad at 8): turn the correction off or use more half periods.
+    VibrationCoeff,
     /// Non-finite or non-positive physical parameter, or a nominal detector
     /// level too dim for the error scaling's range.
     Physical,
+}
+
+/// The compiled copies of the closure step: the reference instruments'
+/// layouts (16 or 32 half periods of 4 samples, 1 skipped, no DAC latency)
+/// with the sizes as constants (divisions become shifts, loops unroll), and
+/// any layout with runtime sizes, without or with one step of DAC latency.
+/// Chosen once here so the interrupt dispatches on one load.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    Half16,
+    Half32,
+    Any,
+    AnyLatency1,
 }
 
 /// Fixed-point constants derived from [`FogParams`]; read-only in the interrupt.
@@ -116,6 +141,8 @@ pub struct FogConfig {
     /// Samples per half period and samples skipped after each edge.
     pub samples_per_half: usize,
     pub skip_samples: usize,
+    /// Which compiled copy of the closure step runs this layout.
+    pub kernel: Kernel,
     /// phi0 as [`Phase`] LSB.
     pub phi0: Phase,
     /// Residual per normalised demodulator count: `cot(phi0/2) * 2^32/(2*pi*n_half)`
@@ -133,9 +160,9 @@ pub struct FogConfig {
     /// Clamp of the digital gain (codes per turn, Q8).
     pub cpt_min_q8: u32,
     pub cpt_max_q8: u32,
-    /// Epsilon-squared correction: output bias (phase LSB, Q16) per product of two
-    /// in-step residual slope (2^8 phase LSB) and previous mean residual (phase
-    /// LSB); Q30.
+    /// Epsilon-squared correction: -(cot(phi0)/n_half) * 512*pi in Q21, the
+    /// factor from the in-step slope (2^8 phase LSB) to -(cot(phi0)/n_half) *
+    /// slope in rad, Q32 (see vibration.rs). Below 2^31 in magnitude.
     pub vib_coeff: i32,
     /// DC moment correction: weight of the in-step spread, 2^8 * 2(n^2-1)/(3n^2).
     pub dc_spread_q8: i32,
@@ -202,7 +229,8 @@ impl FogConfig {
         if !(p.loop_gain > 0.0
             && p.loop_gain < 2.0
             && p.gain_loop_gain >= 0.0
-            && p.gain_loop_gain < 1.0)
+            && p.gain_loop_gain < 1.0
+            && p.dac_latency_steps <= 1)
         {
             return Err(ConfigError::LoopGain);
         }
@@ -217,16 +245,18 @@ impl FogConfig {
         let cot_phi0 = 1.0 / p.phi0_rad.tan();
         let h0_nominal = p.nominal_dc_lsb * kept;
 
-        // Epsilon-squared correction, derived in vibration.rs:
-        // d = -(cot(phi0)/n_half) * da * dbar  [rad], da, dbar in rad.
-        // With da in units of 2^8 LSB, dbar in LSB and d in LSB*2^16:
-        // d_q16 = coeff_real * da' * dbar', coeff_real = -(cot phi0/n) * 2^8 * LSB_rad * 2^16.
-        let coeff_real = -(cot_phi0 / n_half as f64) * 256.0 * crate::RAD_PER_PHASE_LSB * 65_536.0;
-        // Q30, saturated to an i32: |coeff_real| < 2 (the reference instruments
-        // need about 0.002; phi0 = 0.1 rad with 4 half periods needs 0.06).
-        let vib_coeff = (coeff_real * (1u64 << super::vibration::COEFF_FRAC) as f64)
-            .round()
-            .clamp(i32::MIN as f64, i32::MAX as f64) as i32;
+        // Epsilon-squared correction (vibration.rs): u = -(cot(phi0)/n) * d
+        // [rad, Q32] from the slope d in units of 2^8 LSB is
+        // smmul(slope << 11, coeff) with coeff = -(cot(phi0)/n) * 512*pi *
+        // 2^21 (the reference instruments: 5.3e7 and 6.4e7).
+        let coeff_real = -(cot_phi0 / n_half as f64)
+            * 512.0
+            * PI
+            * (1u64 << super::vibration::COEFF_FRAC) as f64;
+        if p.vibration_correction && coeff_real.abs() >= 2_147_483_647.0 {
+            return Err(ConfigError::VibrationCoeff);
+        }
+        let vib_coeff = coeff_real.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32;
 
         // Dither: +-codes * (ADC LSB) of level, at A*sin(phi0) level per rad.
         let amplitude = p.nominal_dc_lsb / (1.0 + p.phi0_rad.cos());
@@ -315,6 +345,17 @@ impl FogConfig {
             n_samples: n_half * p.samples_per_half,
             samples_per_half: p.samples_per_half,
             skip_samples: p.skip_samples,
+            kernel: match (
+                n_half,
+                p.samples_per_half,
+                p.skip_samples,
+                p.dac_latency_steps,
+            ) {
+                (16, 4, 1, 0) => Kernel::Half16,
+                (32, 4, 1, 0) => Kernel::Half32,
+                (_, _, _, 0) => Kernel::Any,
+                _ => Kernel::AnyLatency1,
+            },
             phi0: phase_from_rad(p.phi0_rad),
             k_meas: k_meas.round() as u32,
             loop_gain_q16: (p.loop_gain * 65_536.0).round() as i32,
@@ -355,12 +396,19 @@ impl FogConfig {
 
     /// Predicted epsilon-squared drift of this loop, rad/s, for mean eps^2 (rad/s^2)^2
     /// in the quasi-static limit (vibration well below the loop bandwidth):
-    /// `-(cot(phi0)/2) * K_s * tau * (dt_p/g) * <eps^2>`; for unit gain this is
-    /// physics.md's `-(1/4) cot(phi0) K_s eps^2 dt_m dt_p`.
+    /// `-(cot(phi0)/2) * K_s * tau * dt_p * (1/g + L) * <eps^2>`; for unit gain
+    /// and no latency this is physics.md's `-(1/4) cot(phi0) K_s eps^2 dt_m dt_p`.
+    /// The mean residual under a rate ramp a is a*dt_p*(1/g + L): the loop
+    /// `s(k+1+L) = s(k+L) + g*(m(k) - s(k+L))` (closure.rs) settles with
+    /// `s(k) = a*(k - 1/g - L)`, and the drift is proportional to it.
     pub fn predicted_vibration_drift(&self, mean_eps_sq: f64) -> f64 {
         let p = &self.params;
-        -(1.0 / p.phi0_rad.tan()) / 2.0 * self.k_sagnac_s * p.tau_s * self.closure_period_s()
-            / p.loop_gain
+        let lag_steps = 1.0 / p.loop_gain + p.dac_latency_steps as f64;
+        -(1.0 / p.phi0_rad.tan()) / 2.0
+            * self.k_sagnac_s
+            * p.tau_s
+            * self.closure_period_s()
+            * lag_steps
             * mean_eps_sq
     }
 }

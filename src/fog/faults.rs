@@ -9,7 +9,9 @@ impl Faults {
     pub const OPTICAL_POWER_LOW: u16 = 1 << 0;
     /// Residual beyond pi/2 for several steps: loop keeps integrating to relock.
     pub const OUT_OF_LOCK: u16 = 1 << 1;
-    /// A kept ADC sample at a rail: that step's error is discarded (loop held).
+    /// The ADC's analog watchdog fired during the step: the main loop keeps
+    /// running on the error's sign; the 2*pi loop, the AGC and the
+    /// epsilon-squared correction pause.
     pub const ADC_SATURATION: u16 = 1 << 2;
     /// Firmware: a frame could not be queued; its steps went into the next frame.
     pub const QUEUE_FULL: u16 = 1 << 3;

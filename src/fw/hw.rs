@@ -8,9 +8,10 @@
 //! - Modulator: external 16-bit DAC on SPI1 (PA5 SCK, PA7 MOSI, PA4 NSS); TIM1
 //!   update at 200 kHz requests one word per half period through DMA2 stream 5,
 //!   circular over two steps. The interrupt writes the half the DMA is not reading.
-//!   This ping-pong delays the new step by one closure period (the QEMU and host
-//!   rigs apply it on the next step); physics.md's coefficient must be re-derived
-//!   for that loop before trusting the epsilon-squared correction on the board.
+//!   This ping-pong delays the new step by one closure period
+//!   (`dac_latency_steps = 1`): the closure keeps the words in flight and
+//!   closes the loop as a Smith predictor, and the host rigs simulate the same
+//!   ping-pong (host-tests `fog_latency`).
 //! - Frames on USART1 (PA9) at 2 Mbaud; independent watchdog at 100 ms.
 //! - RLG: the readout's quadrature pair on PB6/PB7 (TIM4 CH1/CH2, AF2, digital
 //!   filter 8 samples) counts in encoder mode 3 (every edge of both inputs,
@@ -139,7 +140,11 @@ pub fn run() -> ! {
     };
     let (mut temps_tx, temps_rx) = temp_queue.split();
 
-    let params = FogParams::default();
+    // The DMA ping-pong applies the words written now the step after next.
+    let params = FogParams {
+        dac_latency_steps: 1,
+        ..FogParams::default()
+    };
     let Ok(cfg) = FogConfig::new(params) else {
         reset()
     };

@@ -14,7 +14,10 @@ pub struct FogRig<F> {
     pub profile: Profile<F>,
     k_sagnac: F,
     step_index: u64,
-    dac: [u16; MAX_HALF],
+    /// DAC buffers: [0] is applied this step and receives the closure's new
+    /// words. With one step of DAC latency the two swap after each step (the
+    /// hw DMA ping-pong: words written now are applied the step after next).
+    dac: [[u16; MAX_HALF]; 2],
     adc: [u16; MAX_HALF * MAX_SAMPLES_PER_HALF],
     sagnac: [F; MAX_HALF],
     /// The ADC analog watchdog fired during the last simulated step.
@@ -37,8 +40,9 @@ where
 {
     pub fn new(cfg: FogConfig, optics: OpticsParams<F>, profile: Profile<F>) -> Self {
         let mut fog = FogLoop::new(&cfg);
-        let mut dac = [0u16; MAX_HALF];
-        fog.start(&cfg, &mut dac);
+        let mut dac = [[0u16; MAX_HALF]; 2];
+        fog.start(&cfg, &mut dac[0]);
+        dac[1] = dac[0];
         Self {
             k_sagnac: F::from(cfg.k_sagnac_s).unwrap_or(F::one()),
             cfg,
@@ -79,7 +83,7 @@ where
             *s = self.k_sagnac * rate;
         }
         let ns = self.cfg.n_samples;
-        let (dac, adc, sagnac) = (&self.dac[..n], &mut self.adc[..ns], &self.sagnac[..n]);
+        let (dac, adc, sagnac) = (&self.dac[0][..n], &mut self.adc[..ns], &self.sagnac[..n]);
         self.adc_over_range = self.optics.run_step(dac, sagnac, adc);
         sum / F::from(n).unwrap_or(F::one())
     }
@@ -93,13 +97,16 @@ where
             &self.cfg,
             &self.adc[..ns],
             self.adc_over_range,
-            &mut self.dac[..n],
+            &mut self.dac[0][..n],
         )
     }
 
     /// Completes a step run as `simulate_optics` + `process_core`.
     pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
         self.step_index += 1;
+        if self.cfg.params.dac_latency_steps != 0 {
+            self.dac.swap(0, 1);
+        }
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
         let t_end = F::from(self.step_index * self.cfg.n_half as u64).unwrap_or(F::zero()) * tau;
         RigStep {
