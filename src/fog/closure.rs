@@ -251,9 +251,12 @@ impl FogLoop {
             // several steps, as it would anyway).
             let neg_sum = -(sums.first + sums.second);
             residual = shr_saturate::<16, 32>(neg_sum as i64 * kn as i64);
-            // In-step slope, 2^8 phase LSB, saturated at +-2^20 (0.37 rad).
+            // In-step slope (second half's residual less the first's), 2^-3
+            // phase LSB, saturated to the i32 range (+-0.37 rad).
             let diff = sums.first - sums.second;
-            let slope = shr_saturate::<23, 21>(diff as i64 * kn as i64);
+            let slope_q3 = shr_saturate::<12, 32>(diff as i64 * kn as i64);
+            // The same in 2^8 LSB, saturated at +-2^20.
+            let slope = slope_q3 >> 11;
 
             // Clipped samples still give the error's sign, so the main loop keeps
             // running through over-range (holding it could lock it there); the
@@ -290,7 +293,7 @@ impl FogLoop {
                     );
                 }
                 if cfg.vibration_correction {
-                    bias = self.vibration.update(slope, residual, cfg.vib_coeff);
+                    bias = self.vibration.update(slope_q3, residual, cfg.vib_coeff);
                 }
                 // The DC filter takes the DC the light would give with no
                 // residual: the step's spread of residual raises the DC by

@@ -161,8 +161,9 @@ pub struct FogConfig {
     pub cpt_min_q8: u32,
     pub cpt_max_q8: u32,
     /// Epsilon-squared correction: -(cot(phi0)/n_half) * 512*pi in Q21, the
-    /// factor from the in-step slope (2^8 phase LSB) to -(cot(phi0)/n_half) *
-    /// slope in rad, Q32 (see vibration.rs). Below 2^31 in magnitude.
+    /// factor from the in-step slope (2^-3 phase LSB) to -(cot(phi0)/n_half) *
+    /// slope in rad, Q32, by one `smmul` (see vibration.rs). Below 2^31 in
+    /// magnitude.
     pub vib_coeff: i32,
     /// DC moment correction: weight of the in-step spread, 2^8 * 2(n^2-1)/(3n^2).
     pub dc_spread_q8: i32,
@@ -246,9 +247,9 @@ impl FogConfig {
         let h0_nominal = p.nominal_dc_lsb * kept;
 
         // Epsilon-squared correction (vibration.rs): u = -(cot(phi0)/n) * d
-        // [rad, Q32] from the slope d in units of 2^8 LSB is
-        // smmul(slope << 11, coeff) with coeff = -(cot(phi0)/n) * 512*pi *
-        // 2^21 (the reference instruments: 5.3e7 and 6.4e7).
+        // [rad, Q32] from the slope d in units of 2^-3 LSB is
+        // smmul(slope, coeff) with coeff = -(cot(phi0)/n) * 512*pi * 2^21
+        // (the reference instruments: 5.3e7 and 6.4e7).
         let coeff_real = -(cot_phi0 / n_half as f64)
             * 512.0
             * PI

@@ -34,10 +34,6 @@ pub struct VibrationCorrection {
     frac: u32,
 }
 
-/// Slopes are saturated to this (2^8 LSB units, about 0.37 rad): beyond that
-/// the loop is not tracking and the correction is meaningless.
-const SLOPE_LIMIT: i32 = 1 << 20;
-
 /// Residuals are saturated to this (phase LSB, pi/8 rad), so r^2 in Q32 fits.
 const RESIDUAL_LIMIT: i32 = 1 << 28;
 
@@ -50,19 +46,19 @@ const R2_SCALE: i32 = 1_324_675_879; // pi^2/32 * 2^32, rounded
 pub const COEFF_FRAC: u32 = 21;
 
 impl VibrationCorrection {
-    /// Takes this step's slope d (2^8 phase LSB, any value: saturated here),
-    /// its mean residual r (phase LSB) and the coefficient
+    /// Takes this step's slope d (2^-3 phase LSB: the i32 range is +-0.37 rad,
+    /// beyond which the loop is not tracking and the correction means
+    /// nothing), its mean residual r (phase LSB) and the coefficient
     /// -(cot(phi0)/n) * 512*pi in Q[`COEFF_FRAC`]; returns the bias to
     /// subtract from the output step, whole phase LSB (the fraction is
     /// carried, no loss; |bias| < 2^27).
     #[inline(always)]
-    pub fn update(&mut self, slope: i32, residual: i32, coeff: i32) -> i32 {
-        // Power-of-two ranges: one `ssat` each on the M4.
-        let slope = slope.clamp(-SLOPE_LIMIT, SLOPE_LIMIT - 1);
+    pub fn update(&mut self, slope_q3: i32, residual: i32, coeff: i32) -> i32 {
+        // A power-of-two range: one `ssat` on the M4.
         let r = residual.clamp(-RESIDUAL_LIMIT, RESIDUAL_LIMIT - 1);
-        // u = -(cot(phi0)/n) * d [rad], Q32: (slope << 11) fills an i32 and
-        // config keeps |coeff| < 2^31, so |u| < 0.24 * 2^32.
-        let u = smmul(slope << 11, coeff);
+        // u = -(cot(phi0)/n) * d [rad], Q32: config keeps |coeff| < 2^31, so
+        // |u| < 0.24 * 2^32.
+        let u = smmul(slope_q3, coeff);
         // q = r^2 [rad^2], Q32: r << 3 fills an i32, t < 2^30, q < 0.16 * 2^32.
         let t = smmul(r << 3, r << 3);
         let q = smmul(t << 1, R2_SCALE);

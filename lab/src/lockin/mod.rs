@@ -219,23 +219,29 @@ pub fn bench_run(a: &LockinBenchArgs) -> Result<(), LabError> {
                 a.seeds
             );
             println!(
-                "{:>8} {:>10} | {:>10} {:>10} {:>10} | {:>12} {:>11}",
+                "{:>8} {:>10} | {:>10} {:>10} {:>10} | {:>10} {:>10} {:>10} | {:>12} {:>11}",
                 "OI/OL",
                 "OL deg/s",
-                "exact rms%",
-                "exact max%",
-                "fit 1sig%",
+                "S rms%",
+                "S max%",
+                "S 1sig%",
+                "S+Q rms%",
+                "S+Q max%",
+                "S+Q 1sig%",
                 "approx mean%",
                 "approx max%"
             );
             for r in &rows {
                 println!(
-                    "{:>8.0} {:>10.4} | {:>10.3} {:>10.3} {:>10.3} | {:>12.2} {:>11.2}",
+                    "{:>8.0} {:>10.4} | {:>10.3} {:>10.3} {:>10.3} | {:>10.3} {:>10.3} {:>10.3} | {:>12.2} {:>11.2}",
                     r.ratio,
                     r.lock_in_dps,
                     r.exact_rms_pct,
                     r.exact_max_pct,
                     r.exact_std_pct,
+                    r.pair_rms_pct,
+                    r.pair_max_pct,
+                    r.pair_std_pct,
                     r.approx_mean_pct,
                     r.approx_max_pct
                 );
