@@ -3,8 +3,8 @@
 //! | offset | type | field |
 //! |---|---|---|
 //! | 0 | u8 x2 | sync 0xA5 0x5A |
-//! | 2 | u8 | version (2) |
-//! | 3 | u8 | payload length after this byte, CRC included (60) |
+//! | 2 | u8 | version (3) |
+//! | 3 | u8 | payload length after this byte, CRC included (82) |
 //! | 4 | u16 | sequence number (wraps) |
 //! | 6 | u16 | fault flags, OR over the frame's steps ([`crate::fog::Faults`]) |
 //! | 8 | u16 | closure steps in this frame |
@@ -20,16 +20,25 @@
 //! | 54 | i16 x3 | RLG temperatures in use: monoblock A, monoblock B, case; Q8 degC |
 //! | 60 | u8 | RLG flags ([`crate::rlg::thermal::flags`]: sensor A, B, case bad; coefficients refused) |
 //! | 61 | u8 | reserved (0) |
-//! | 62 | u16 | CRC-16/CCITT-FALSE over bytes 2..62 |
+//! | 62 | i64 | FOG angle increment compensated: the corrected angle with the scale factor and bias over coil temperature applied ([`crate::fog::scale_factor`]), same LSB |
+//! | 70 | i32 | FOG scale-factor correction in use: output times 1 + x/2^32 |
+//! | 74 | i32 | FOG bias removed, Q16 deg/h |
+//! | 78 | i16 | FOG coil temperature the table was read at (sensor plus lag lead), Q8 degC |
+//! | 80 | i16 | FOG coil sensor value in use (held while bad), Q8 degC |
+//! | 82 | u8 | FOG temperature flags ([`crate::fog::scale_factor::flags`]: coil sensor bad, out of the calibrated range, table refused) |
+//! | 83 | u8 | reserved (0) |
+//! | 84 | u16 | CRC-16/CCITT-FALSE over bytes 2..84 |
 //!
-//! Version 1 (44 bytes) was the FOG part alone.
+//! Version 1 (44 bytes) was the FOG part alone; version 2 (64 bytes) ended
+//! after byte 61.
 
+use crate::fog::scale_factor::{FogTempWords, ScaleFactorComp, ScaleFactorConfig};
 use crate::rlg::RlgWords;
 use crc::{Crc, CRC_16_IBM_3740};
 
-pub const FRAME_LEN: usize = 64;
+pub const FRAME_LEN: usize = 86;
 pub const SYNC: [u8; 2] = [0xA5, 0x5A];
-pub const VERSION: u8 = 2;
+pub const VERSION: u8 = 3;
 const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -44,6 +53,8 @@ pub struct Frame {
     pub codes_per_turn_q8: u32,
     pub dc: u32,
     pub rlg: RlgWords,
+    pub fog_angle_comp: i64,
+    pub fog_temp: FogTempWords,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,6 +91,13 @@ impl Frame {
         w.put(&g.t_mono_b_q8.to_le_bytes());
         w.put(&g.t_case_q8.to_le_bytes());
         w.put(&[g.flags, 0]);
+        w.put(&self.fog_angle_comp.to_le_bytes());
+        let t = &self.fog_temp;
+        w.put(&t.sf_corr_q32.to_le_bytes());
+        w.put(&t.bias_q16_dph.to_le_bytes());
+        w.put(&t.t_coil_q8.to_le_bytes());
+        w.put(&t.t_sensor_q8.to_le_bytes());
+        w.put(&[t.flags, 0]);
         let crc = CRC16.checksum(b.get(2..FRAME_LEN - 2).unwrap_or(&[]));
         if let Some(t) = b.get_mut(FRAME_LEN - 2..) {
             t.copy_from_slice(&crc.to_le_bytes());
@@ -125,7 +143,27 @@ impl Frame {
                 t_case_q8: i16::from_le_bytes(r.take()),
                 flags: r.take::<1>()[0],
             },
+            fog_angle_comp: {
+                r.pos += 1; // reserved byte 61
+                i64::from_le_bytes(r.take())
+            },
+            fog_temp: FogTempWords {
+                sf_corr_q32: i32::from_le_bytes(r.take()),
+                bias_q16_dph: i32::from_le_bytes(r.take()),
+                t_coil_q8: i16::from_le_bytes(r.take()),
+                t_sensor_q8: i16::from_le_bytes(r.take()),
+                flags: r.take::<1>()[0],
+            },
         })
+    }
+
+    /// Fills the compensated FOG angle and its words from the frame's
+    /// corrected angle (at frame completion, so a frame merged back after a
+    /// full queue is compensated whole).
+    pub fn compensate_fog(&mut self, sf: &ScaleFactorComp, cfg: &ScaleFactorConfig) {
+        let (angle, words) = sf.compensate(cfg, self.fog_angle, self.steps);
+        self.fog_angle_comp = angle;
+        self.fog_temp = words;
     }
 }
 

@@ -10,10 +10,12 @@
 //! - Modulator DAC codes: `u16`.
 #![no_std]
 
+pub mod derivative;
 pub mod drivers;
 pub mod fog;
 pub mod frame;
 pub mod rlg;
+pub mod sensor;
 pub mod sim;
 
 /// Phase with one turn = 2^32 LSB (wrapping arithmetic is the 2*pi reset).

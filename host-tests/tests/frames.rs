@@ -1,6 +1,9 @@
 //! Output frames: round trip, CRC, no loss of angle when the queue is full.
 
-use gyro_sp::fog::{ClosureOutput, Faults};
+use gyro_sp::fog::scale_factor::{
+    FogTempWords, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable,
+};
+use gyro_sp::fog::{ClosureOutput, Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
 use gyro_sp::rlg::RlgWords;
 use proptest::prelude::*;
@@ -34,6 +37,14 @@ fn round_trip_and_crc() {
             t_case_q8: 20 * 256,
             flags: 0b1010,
         },
+        fog_angle_comp: -(1 << 50) + 17,
+        fog_temp: FogTempWords {
+            sf_corr_q32: -859_000,
+            bias_q16_dph: 31_000,
+            t_coil_q8: 48 * 256 + 7,
+            t_sensor_q8: -40 * 256,
+            flags: 0b110,
+        },
     };
     let b = f.encode();
     assert_eq!(Frame::decode(&b), Ok(f));
@@ -43,18 +54,33 @@ fn round_trip_and_crc() {
     let mut bad = b;
     bad[57] ^= 0x80;
     assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
+    let mut bad = b;
+    bad[81] ^= 0x01;
+    assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
     assert_eq!(Frame::decode(&b[..FRAME_LEN - 1]), Err(FrameError::Length));
+}
+
+/// A table that scales by exactly 1/(1 + 100 ppm) and removes no bias.
+fn sf_table() -> (ScaleFactorConfig, ScaleFactorComp) {
+    let fog = FogConfig::new(FogParams::default()).unwrap();
+    let t = ScaleFactorTable::from_nodes(&[0.0, 50.0], &[100.0, 100.0], &[0.0, 0.0], 0.0);
+    let cfg = ScaleFactorConfig::new(&t, &fog, 1.0);
+    let mut comp = ScaleFactorComp::default();
+    comp.update_temperature(&cfg, Some(25 * 256));
+    (cfg, comp)
 }
 
 #[test]
 fn restored_frame_loses_no_angle() {
+    let (sf_cfg, sf) = sf_table();
     let mut fb = FrameBuilder::new(4, 16);
     let mut emitted = Vec::new();
     let mut total = 0i64;
     let mut refused = std::collections::HashSet::new();
     for k in 0..40 {
         total += (k - 3) * 16;
-        if let Some(f) = fb.push(&out(k), k as u32 + 1) {
+        if let Some(mut f) = fb.push(&out(k), k as u32 + 1) {
+            f.compensate_fog(&sf, &sf_cfg);
             // Every other frame "does not fit in the queue".
             if f.seq % 2 == 1 && refused.insert(f.seq) {
                 fb.restore(f);
@@ -67,6 +93,15 @@ fn restored_frame_loses_no_angle() {
     let pending = 40 - emitted.iter().map(|f| f.steps as i64).sum::<i64>();
     let pending_angle: i64 = (40 - pending..40).map(|k| (k - 3) * 16).sum();
     assert_eq!(sent + pending_angle, total);
+    // The compensated angle of a frame merged back is compensated whole
+    // with the next: the sent compensated angles are the sent angles
+    // scaled, to the multiply's rounding (one LSB per frame).
+    let comp: i64 = emitted.iter().map(|f| f.fog_angle_comp).sum();
+    let expected = sent as f64 / (1.0 + 100e-6);
+    assert!(
+        (comp as f64 - expected).abs() <= emitted.len() as f64 + 1.0,
+        "{comp} vs {expected}"
+    );
     assert!(emitted.iter().any(|f| f.faults & Faults::QUEUE_FULL != 0));
     for w in emitted.windows(2) {
         assert_eq!(

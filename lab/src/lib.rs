@@ -3,6 +3,8 @@
 
 pub mod error;
 pub mod lockin;
+pub mod lsq;
+pub mod scale_factor;
 pub mod simulate;
 pub mod table;
 pub mod thermal;

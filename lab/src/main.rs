@@ -3,7 +3,7 @@
 //! error naming the file, line and column.
 
 use gyro_lab::error::LabError;
-use gyro_lab::{lockin, simulate, thermal};
+use gyro_lab::{lockin, scale_factor, simulate, thermal};
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -41,12 +41,16 @@ enum Cmd {
 enum FitCmd {
     /// RLG thermal bias model (two monoblock sensors, case sensor, gradient, warm-up).
     Thermal(thermal::FitThermalArgs),
+    /// FOG scale factor over temperature (knees by BIC) from a continuous-rotation or multi-point run.
+    ScaleFactor(scale_factor::FitArgs),
 }
 
 #[derive(Subcommand)]
 enum BenchCmd {
     /// Lock-in: exact harmonic relation next to the published approximate formula.
     Lockin(lockin::LockinBenchArgs),
+    /// FOG scale factor: raw, classic multi-point and continuous rotation on one simulated gyro.
+    ScaleFactor(scale_factor::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -62,8 +66,10 @@ fn main() -> ExitCode {
         Cmd::Simulate(c) => simulate::run(c),
         Cmd::Lockin(a) => lockin::run(&a),
         Cmd::Fit(FitCmd::Thermal(a)) => thermal::fit_run(&a),
+        Cmd::Fit(FitCmd::ScaleFactor(a)) => scale_factor::fit_run(&a),
         Cmd::Compensate(a) => thermal::compensate_run(&a),
         Cmd::Bench(BenchCmd::Lockin(a)) => lockin::bench_run(&a),
+        Cmd::Bench(BenchCmd::ScaleFactor(a)) => scale_factor::bench::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

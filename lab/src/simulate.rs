@@ -19,6 +19,8 @@ pub enum SimulateCmd {
     Lockin(crate::lockin::LockinSimArgs),
     /// RLG in a thermal chamber (writes a run file).
     Chamber(crate::thermal::chamber::ChamberArgs),
+    /// FOG scale-factor calibration run over temperature (continuous rotation or multi-point; writes a run file).
+    ScaleFactor(crate::scale_factor::SimulateArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -94,6 +96,7 @@ pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
     match cmd {
         SimulateCmd::Lockin(a) => crate::lockin::simulate(&a),
         SimulateCmd::Chamber(a) => crate::thermal::chamber::simulate(&a),
+        SimulateCmd::ScaleFactor(a) => crate::scale_factor::simulate(&a),
         SimulateCmd::Fog(a) => {
             let s = simulate_fog(&a)?;
             if a.json {

@@ -91,6 +91,28 @@ impl Table {
         })
     }
 
+    /// `file:line:column (column `name`)` of a column's header cell, for
+    /// errors about the column as a whole.
+    pub fn column_place(&self, col: &str) -> String {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == col)
+            .map_or(0, |i| i + 1);
+        format!("{}:{}:{i} (column `{col}`)", self.name(), self.header_line)
+    }
+
+    /// `file:line:column` of the cell of data row `row` (0-based) in `col`.
+    pub fn cell_place(&self, row: usize, col: &str) -> String {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == col)
+            .map_or(0, |i| i + 1);
+        let line = self.rows.get(row).map_or(self.header_line, |r| r.0);
+        format!("{}:{line}:{i} (column `{col}`)", self.name())
+    }
+
     /// A numeric column: every cell a finite number.
     pub fn column(&self, col: &str) -> Result<Vec<f64>, LabError> {
         let i = self.index(col)?;

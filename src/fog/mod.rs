@@ -5,7 +5,8 @@
 //! Data flow per closure step (one interrupt, `n_half` half periods of tau):
 //! ADC batch -> [`demod`] -> main loop ([`closure`]) and [`gain_loop`] ->
 //! [`modulator`] writes the DAC words of the next step; [`vibration`] corrects
-//! the output; [`faults`] flags what went wrong.
+//! the output; [`faults`] flags what went wrong. At the frame rate,
+//! [`scale_factor`] applies the scale factor and bias over coil temperature.
 
 pub mod closure;
 pub mod config;
@@ -13,6 +14,7 @@ pub mod demod;
 pub mod faults;
 pub mod gain_loop;
 pub mod modulator;
+pub mod scale_factor;
 pub mod vibration;
 
 pub use closure::{ClosureOutput, FogLoop};

@@ -23,17 +23,24 @@
 //!   through a queue, so no bus transfer runs in an interrupt. The closure
 //!   interrupt puts the RLG words into each frame. Coefficients come from the
 //!   build-time record (build.rs, `RLG_COEFFS`) and are checked at start.
+//! - FOG coil temperature: a fourth TMP117 (0x4B) on the same bus, read by
+//!   the main loop at 1 Hz and queued to the closure interrupt, which
+//!   advances the scale-factor table's state; each completed frame gets the
+//!   table applied (build-time record, `FOG_SF_COEFFS`).
 //!
 //! Registers are written as whole words with the bit meaning in the comment.
 
 use super::i2c::I2c1;
-use super::{stack, uart, FrameQueue, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME};
+use super::{
+    stack, uart, FrameQueue, FOG_SF_RECORD, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME,
+};
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::Mutex;
 use defmt_rtt as _;
 use gyro_sp::drivers::tmp117::Tmp117;
 use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
+use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig};
 use gyro_sp::fog::{Faults, FogConfig, FogLoop, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
@@ -45,6 +52,12 @@ use stm32f4::stm32f405::{self as pac, interrupt, Interrupt};
 const RLG_COUNTS_PER_DEG: f64 = 8_000.0;
 /// Readings from the main loop to the RLG update interrupt.
 type TempQueue = Queue<Temperatures, 2>;
+/// Coil readings (Q8 degC, None: failed) from the main loop to the closure.
+type CoilQueue = Queue<Option<i32>, 2>;
+/// The coil sensor is read every this many sensor cycles (1 Hz): a slower
+/// derivative for the lag lead is a quieter one (its noise scales as
+/// 1/sqrt(period)).
+const COIL_EVERY: u32 = 10;
 /// RLG updates so far (the main loop times the sensor reads by it).
 static RLG_TICKS: AtomicU32 = AtomicU32::new(0);
 
@@ -69,6 +82,9 @@ struct Ctx {
     encoder: pac::TIM4,
     rlg_timer: pac::TIM5,
     temps: Consumer<'static, Temperatures, 2>,
+    sf_cfg: ScaleFactorConfig,
+    sf: ScaleFactorComp,
+    coil: Consumer<'static, Option<i32>, 2>,
 }
 
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
@@ -109,7 +125,8 @@ pub fn run() -> ! {
         .modify(|r, w| unsafe { w.bits((r.bits() & !(0xFF << 24)) | (0x22 << 24)) });
     let mut i2c = I2c1::new(dp.I2C1, &dp.GPIOB);
     let sensors = [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)];
-    for s in &sensors {
+    let coil_sensor = Tmp117::new(0x4B);
+    for s in sensors.iter().chain([&coil_sensor]) {
         if s.init(&mut i2c).is_err() {
             defmt::warn!(
                 "TMP117 at {=u8:#x} does not answer: its reads will be flagged",
@@ -139,6 +156,10 @@ pub fn run() -> ! {
         reset()
     };
     let (mut temps_tx, temps_rx) = temp_queue.split();
+    let Some(coil_queue) = cortex_m::singleton!(: CoilQueue = CoilQueue::new()) else {
+        reset()
+    };
+    let (mut coil_tx, coil_rx) = coil_queue.split();
 
     // The DMA ping-pong applies the words written now the step after next.
     let params = FogParams {
@@ -149,6 +170,11 @@ pub fn run() -> ! {
         reset()
     };
     let mut fog = FogLoop::new(&cfg);
+    let coil_dt_s = (SENSOR_EVERY * COIL_EVERY) as f64 / RLG_HZ as f64;
+    let sf_cfg = ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, coil_dt_s);
+    if sf_cfg.coeffs_refused {
+        defmt::warn!("FOG scale-factor record refused: running without temperature compensation");
+    }
     // Both DAC halves start with valid words.
     let dac = unsafe { &mut *core::ptr::addr_of_mut!(DAC_BUF) };
     let (a, b) = dac.split_at_mut(N_HALF);
@@ -244,6 +270,9 @@ pub fn run() -> ! {
             encoder: dp.TIM4,
             rlg_timer: tim5,
             temps: temps_rx,
+            sf_cfg,
+            sf: ScaleFactorComp::default(),
+            coil: coil_rx,
         }))
     });
     unsafe {
@@ -260,6 +289,7 @@ pub fn run() -> ! {
         RLG_HZ
     );
     let mut last_read = 0u32;
+    let mut cycles = 0u32;
     loop {
         while let Some(f) = rx.dequeue() {
             uart::write(&usart, &f.encode());
@@ -276,6 +306,10 @@ pub fn run() -> ! {
             // Full only if the update interrupt has stopped; the reading is
             // then stale anyway.
             let _ = temps_tx.enqueue(t);
+            if cycles.is_multiple_of(COIL_EVERY) {
+                let _ = coil_tx.enqueue(coil_sensor.read(&mut i2c));
+            }
+            cycles = cycles.wrapping_add(1);
         }
         iwdg.kr().write(|w| unsafe { w.bits(0xAAAA) });
         cortex_m::asm::wfi();
@@ -339,7 +373,11 @@ fn DMA2_STREAM0() {
             let (counts, n) = ctx.rlg.take_frame();
             ctx.frames.set_rlg(ctx.rlg.words(&ctx.rlg_cfg, counts, n));
         }
-        if let Some(f) = ctx.frames.push(&out, ctx.counter) {
+        if let Some(read) = ctx.coil.dequeue() {
+            ctx.sf.update_temperature(&ctx.sf_cfg, read);
+        }
+        if let Some(mut f) = ctx.frames.push(&out, ctx.counter) {
+            f.compensate_fog(&ctx.sf, &ctx.sf_cfg);
             if let Err(f) = ctx.tx.enqueue(f) {
                 ctx.frames.restore(f);
             }

@@ -11,6 +11,7 @@ pub mod hw;
 #[cfg(all(feature = "hw", not(feature = "qemu")))]
 pub mod i2c;
 
+use gyro_coeffs::fog_scale_factor::RECORD_LEN as FOG_SF_RECORD_LEN;
 use gyro_sp::frame::Frame;
 use gyro_sp::rlg::coeffs::RECORD_LEN;
 use heapless::spsc::Queue;
@@ -30,3 +31,8 @@ pub const SENSOR_EVERY: u32 = 50;
 /// build.rs (`RLG_COEFFS`); checked (CRC, version, ranges) at start.
 pub static RLG_RECORD: [u8; RECORD_LEN] =
     *include_bytes!(concat!(env!("OUT_DIR"), "/rlg_coeffs.bin"));
+
+/// The FOG scale-factor table's record, built from its coefficient file by
+/// build.rs (`FOG_SF_COEFFS`); checked at start.
+pub static FOG_SF_RECORD: [u8; FOG_SF_RECORD_LEN] =
+    *include_bytes!(concat!(env!("OUT_DIR"), "/fog_sf_coeffs.bin"));

@@ -10,8 +10,20 @@
 //! a simulated I2C bus through the real driver. The case sensor stops
 //! answering for a while to show the fault path. Coefficients come from the
 //! build-time record (build.rs, `RLG_COEFFS`).
+//!
+//! The FOG's scale factor and bias vary with its coil temperature
+//! (`sim::fog_thermal`, the gyro `gyro-lab simulate scale-factor` makes):
+//! the coil sweeps at a constant rate from 30 degC across the knee at 48 degC
+//! (and out of the calibrated range at 60 degC after 1.25 s, flagged), and a
+//! fourth simulated TMP117 (0x4B) reads it with its lag. A 2.4 s run cannot
+//! show minutes of chamber time, so the thermal model runs 1000 times faster
+//! than the closure (one sensor read per frame stands for 2 s; the sweep is
+//! 1.44 degC/min in that time), and the firmware's table is configured for
+//! that sensor period. The frame path applies the table (`FOG_SF_COEFFS`).
 
-use super::{stack, uart, FrameQueue, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME};
+use super::{
+    stack, uart, FrameQueue, FOG_SF_RECORD, RLG_HZ, RLG_RECORD, SENSOR_EVERY, STEPS_PER_FRAME,
+};
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::interrupt::Mutex;
@@ -19,11 +31,14 @@ use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::exception;
 use defmt_semihosting as _;
 use gyro_sp::drivers::tmp117::Tmp117;
+use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig};
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{RlgChannel, RlgConfig};
-use gyro_sp::sim::{profile::qemu_demo, Chamber, ChamberParams, FogRig, OpticsParams};
+use gyro_sp::sim::{
+    profile::qemu_demo, Chamber, ChamberParams, CoilThermal, FogRig, OpticsParams, ScaleFactorTruth,
+};
 use heapless::spsc::Producer;
 
 /// SysTick clock of the emulated STM32F405 (QEMU's SYSCLK).
@@ -36,11 +51,19 @@ const POWER_LOSS: core::ops::Range<u32> = 28_500..28_750;
 const _: () = assert!(CLOSURE_HZ / STEPS_PER_FRAME as u32 == RLG_HZ);
 /// The case sensor NACKs during these RLG updates (1.0 .. 1.3 s).
 const CASE_NACK: core::ops::Range<u32> = 500..650;
+/// Thermal seconds per closure second (see the module doc).
+const THERMAL_TIME_SCALE: f64 = 1000.0;
+/// Coil sweep: start, degC, and rate, degC per closure second.
+const COIL_START_C: f64 = 30.0;
+const COIL_RATE_C_PER_S: f64 = 24.0;
+/// TMP117 address of the FOG coil sensor (the fourth ADD0 address).
+const COIL_SENSOR: u8 = 0x4B;
 
 /// Simulated TMP117s on one I2C bus: they answer temperature reads with the
 /// chamber's readings; one address can be made to NACK.
 struct SimI2c {
-    temps_c: [f64; 3],
+    /// 0x48 monoblock A, 0x49 monoblock B, 0x4A case, 0x4B FOG coil.
+    temps_c: [f64; 4],
     nack: Option<u8>,
 }
 
@@ -55,7 +78,7 @@ impl embedded_hal::i2c::I2c for SimI2c {
         operations: &mut [embedded_hal::i2c::Operation<'_>],
     ) -> Result<(), Self::Error> {
         let i = match address {
-            0x48..=0x4A if self.nack != Some(address) => (address - 0x48) as usize,
+            0x48..=0x4B if self.nack != Some(address) => (address - 0x48) as usize,
             _ => return Err(gyro_sp::drivers::tmp117::NACK_ADDRESS),
         };
         let reg = ((self.temps_c[i] * 128.0) as i16).to_be_bytes();
@@ -77,6 +100,20 @@ struct Rlg {
     bus: SimI2c,
     sensors: [Tmp117; 3],
     updates: u32,
+}
+
+/// The FOG's temperature: truth, coil sensor and the table's state.
+struct FogThermal {
+    truth: ScaleFactorTruth,
+    coil: CoilThermal,
+    sensor: Tmp117,
+    cfg: ScaleFactorConfig,
+    comp: ScaleFactorComp,
+}
+
+/// Coil temperature at closure time `t_s`, degC.
+fn coil_at(t_s: f64) -> f64 {
+    COIL_START_C + COIL_RATE_C_PER_S * t_s
 }
 
 struct Bench {
@@ -104,6 +141,9 @@ struct Ctx {
     rig: FogRig<f32>,
     rlg: Rlg,
     rlg_bench: Bench,
+    fog_thermal: FogThermal,
+    sf_bench: Bench,
+    sf_sensor_bench: Bench,
     frames: FrameBuilder,
     tx: Producer<'static, Frame, 8>,
     counter: u32,
@@ -147,30 +187,44 @@ pub fn run() -> ! {
         ch: RlgChannel::default(),
         chamber: Chamber::new(chamber_p, 20.0),
         bus: SimI2c {
-            temps_c: [20.0; 3],
+            temps_c: [20.0; 4],
             nack: None,
         },
         sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
         updates: 0,
     };
+    // One coil sensor read per frame, 2 s of thermal time.
+    let sensor_dt_s = THERMAL_TIME_SCALE * STEPS_PER_FRAME as f64 / CLOSURE_HZ as f64;
+    let fog_thermal = FogThermal {
+        truth: ScaleFactorTruth::default(),
+        coil: CoilThermal::new(COIL_START_C),
+        sensor: Tmp117::new(COIL_SENSOR),
+        cfg: ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, sensor_dt_s),
+        comp: ScaleFactorComp::default(),
+    };
+    if fog_thermal.cfg.coeffs_refused {
+        defmt::warn!("FOG scale-factor record refused: running without temperature compensation");
+    }
+    let mut rig = FogRig::new(cfg, optics, profile);
+    set_fog_truth(&mut rig, &fog_thermal.truth, 0.5 / RLG_HZ as f64);
+    let bench = || Bench {
+        ticks_sum: 0,
+        ticks_max: 0,
+        n: 0,
+    };
     cortex_m::interrupt::free(|cs| {
         CTX.borrow(cs).replace(Some(Ctx {
-            rig: FogRig::new(cfg, optics, profile),
+            rig,
             rlg,
-            rlg_bench: Bench {
-                ticks_sum: 0,
-                ticks_max: 0,
-                n: 0,
-            },
+            rlg_bench: bench(),
+            fog_thermal,
+            sf_bench: bench(),
+            sf_sensor_bench: bench(),
             frames: FrameBuilder::new(STEPS_PER_FRAME, cfg.n_half),
             tx,
             counter: 0,
             total,
-            bench: Bench {
-                ticks_sum: 0,
-                ticks_max: 0,
-                n: 0,
-            },
+            bench: bench(),
         }))
     });
     defmt::info!(
@@ -199,17 +253,16 @@ pub fn run() -> ! {
         cortex_m::asm::wfi();
     }
     syst.disable_interrupt();
-    let ((sum, max, n), (rsum, rmax, rn)) = cortex_m::interrupt::free(|cs| {
-        CTX.borrow(cs)
-            .borrow()
-            .as_ref()
-            .map_or(((0, 0, 0), (0, 0, 0)), |c| {
-                (
-                    (c.bench.ticks_sum, c.bench.ticks_max, c.bench.n),
-                    (c.rlg_bench.ticks_sum, c.rlg_bench.ticks_max, c.rlg_bench.n),
-                )
-            })
-    });
+    let [(sum, max, n), (rsum, rmax, rn), (fsum, fmax, fn_), (ssum, smax, sn)] =
+        cortex_m::interrupt::free(|cs| {
+            CTX.borrow(cs)
+                .borrow()
+                .as_ref()
+                .map_or([(0, 0, 0); 4], |c| {
+                    [&c.bench, &c.rlg_bench, &c.sf_bench, &c.sf_sensor_bench]
+                        .map(|b| (b.ticks_sum, b.ticks_max, b.n))
+                })
+        });
     let mean_instr = sum as f32 / n.max(1) as f32 * ipt;
     defmt::info!("frames sent: {}", sent);
     defmt::info!(
@@ -222,6 +275,13 @@ pub fn run() -> ! {
         "bench: rlg_update_instructions={} rlg_max={}",
         (rsum as f32 / rn.max(1) as f32 * ipt) as u32,
         (rmax as f32 * ipt) as u32
+    );
+    defmt::info!(
+        "bench: fog_sf_frame_instructions={} sf_frame_max={} fog_sf_sensor_instructions={} sf_sensor_max={}",
+        (fsum as f32 / fn_.max(1) as f32 * ipt) as u32,
+        (fmax as f32 * ipt) as u32,
+        (ssum as f32 / sn.max(1) as f32 * ipt) as u32,
+        (smax as f32 * ipt) as u32
     );
     cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_SUCCESS);
     loop {
@@ -260,8 +320,16 @@ fn closure(ctx: &mut Ctx) {
     }
     if ctx.counter.is_multiple_of(STEPS_PER_FRAME as u32) {
         rlg_update(ctx);
+        fog_thermal_update(ctx);
     }
-    if let Some(f) = ctx.frames.push(&out, ctx.counter) {
+    if let Some(mut f) = ctx.frames.push(&out, ctx.counter) {
+        // The frame path's work: the scale-factor table at the coil
+        // temperature, applied to the frame's angle.
+        let th = &ctx.fog_thermal;
+        let t0 = SYST::get_current();
+        f.compensate_fog(&th.comp, &th.cfg);
+        let t1 = SYST::get_current();
+        ctx.sf_bench.record(t0, t1);
         if let Err(f) = ctx.tx.enqueue(f) {
             ctx.frames.restore(f);
         }
@@ -278,7 +346,7 @@ fn rlg_update(ctx: &mut Ctx) {
     let t_mid = (r.updates as f64 + 0.5) * dt;
     let rate_dps = ctx.rig.profile.rate_at(t_mid as f32) as f64 * (180.0 / core::f64::consts::PI);
     let s = r.chamber.step(dt, 20.0, rate_dps);
-    r.bus.temps_c = [s.t_mono_a_c, s.t_mono_b_c, s.t_case_c];
+    r.bus.temps_c[..3].copy_from_slice(&[s.t_mono_a_c, s.t_mono_b_c, s.t_case_c]);
     r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
     let temps = r
         .updates
@@ -297,6 +365,40 @@ fn rlg_update(ctx: &mut Ctx) {
     r.updates += 1;
     let (counts, n) = r.ch.take_frame();
     ctx.frames.set_rlg(r.ch.words(&r.cfg, counts, n));
+}
+
+/// The rig's scale-factor error and bias for the frame centred on closure
+/// time `t_mid`: the truth at the coil temperature then, for the rate's sign.
+fn set_fog_truth(rig: &mut FogRig<f32>, truth: &ScaleFactorTruth, t_mid: f64) {
+    let rate = rig.profile.rate_at(t_mid as f32);
+    let sign = if rate > 0.0 {
+        1.0
+    } else if rate < 0.0 {
+        -1.0
+    } else {
+        0.0
+    };
+    let t_c = coil_at(t_mid);
+    rig.scale_error = (truth.sf_ppm(t_c, sign) * 1e-6) as f32;
+    rig.bias_rad_s = (truth.bias_dph(t_c) / 3600.0 * core::f64::consts::PI / 180.0) as f32;
+}
+
+/// Once per frame: the coil sensor (lagging the coil) is read through the
+/// TMP117 driver and the table's state advances (what the bench times);
+/// the rig takes the truth for the next frame.
+fn fog_thermal_update(ctx: &mut Ctx) {
+    let frame_s = STEPS_PER_FRAME as f64 / CLOSURE_HZ as f64;
+    let t = ctx.counter as f64 / CLOSURE_HZ as f64;
+    let th = &mut ctx.fog_thermal;
+    let sensor_c = th.coil.step_coil(frame_s * THERMAL_TIME_SCALE, coil_at(t));
+    let bus = &mut ctx.rlg.bus;
+    bus.temps_c[3] = sensor_c;
+    let read = th.sensor.read(bus);
+    let t0 = SYST::get_current();
+    th.comp.update_temperature(&th.cfg, read);
+    let t1 = SYST::get_current();
+    ctx.sf_sensor_bench.record(t0, t1);
+    set_fog_truth(&mut ctx.rig, &ctx.fog_thermal.truth, t + 0.5 * frame_s);
 }
 
 /// Instructions per SysTick tick, measured on a loop of known length

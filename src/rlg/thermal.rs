@@ -14,20 +14,18 @@
 //!   Q24), |dT| clamped to 32 degC and temperatures within -55..150 degC keep
 //!   every product below 2^61.
 //!
-//! Sensor faults: a read that failed (NACK, timeout), reads outside
-//! -55..+150 degC or repeats the exact same value for [`STUCK_READS`] reads
-//! marks that sensor bad; the compensation then holds that sensor's last good
-//! value (and the gradient decays to 0), and the flag stays up while it lasts.
+//! Sensor faults ([`crate::sensor`]): a failed, implausible or stuck read
+//! marks that sensor bad; the compensation then holds that sensor's last
+//! good value (and the gradient decays to 0), and the flag stays up while it
+//! lasts.
 
 use super::coeffs::ThermalCoeffs;
+use crate::derivative::{Derivative, DerivativeConfig};
+use crate::sensor::SensorHold;
+pub use crate::sensor::STUCK_READS;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
 
-/// Identical consecutive reads that mark a sensor stuck (TMP117 noise moves the
-/// last bit within a few reads; 64 reads at 8 Hz is 8 s).
-pub const STUCK_READS: u16 = 64;
-const T_MIN_Q8: i32 = -55 * 256;
-const T_MAX_Q8: i32 = 150 * 256;
 /// Gradient filter time constant, s.
 pub const GRAD_TAU_S: f64 = 20.0;
 
@@ -57,10 +55,8 @@ pub struct ThermalConfig {
     k3_q24: i64,
     k4_q24: i64,
     k5_q24: i64,
-    /// 1/dt in Q16 per s.
-    inv_dt_q16: i64,
-    /// Gradient filter weight dt/(tau_g + dt), Q30.
-    grad_a_q30: i64,
+    /// The dT gradient's differentiator.
+    grad: DerivativeConfig,
     /// Warm-up step 1 - exp(-dt/tau_warm), Q30.
     warm_a_q30: i64,
     pub coeffs_default: bool,
@@ -79,7 +75,6 @@ impl ThermalConfig {
         } else {
             1.0
         };
-        let q16 = |x: f64| (x * 65_536.0).round() as i64;
         let q24 = |x: f64| (x * 16_777_216.0).round() as i64;
         let q30 = |x: f64| (x * (1u64 << 30) as f64).round() as i64;
         Self {
@@ -89,8 +84,7 @@ impl ThermalConfig {
             k3_q24: q24(c.k3_dph_per_c2),
             k4_q24: q24(c.k4_dph_per_c),
             k5_q24: q24(c.k5_dph),
-            inv_dt_q16: q16(1.0 / dt),
-            grad_a_q30: q30(dt / (GRAD_TAU_S + dt)),
+            grad: DerivativeConfig::new(dt, GRAD_TAU_S),
             warm_a_q30: q30(1.0 - (-dt / c.tau_warm_s).exp()),
             coeffs_default,
         }
@@ -111,47 +105,13 @@ impl ThermalConfig {
     }
 }
 
-#[derive(Clone, Copy, Debug, Default)]
-struct Sensor {
-    last_good_q8: i32,
-    last_raw: Option<i32>,
-    repeats: u16,
-    seen: bool,
-}
-
-impl Sensor {
-    /// Returns the value to use and whether the sensor is bad.
-    fn take(&mut self, read: Option<i32>) -> (i32, bool) {
-        let bad = match read {
-            Some(t) if (T_MIN_Q8..=T_MAX_Q8).contains(&t) => {
-                if self.last_raw == Some(t) {
-                    self.repeats = self.repeats.saturating_add(1);
-                } else {
-                    self.repeats = 0;
-                }
-                self.last_raw = Some(t);
-                if self.repeats < STUCK_READS {
-                    self.last_good_q8 = t;
-                    self.seen = true;
-                    false
-                } else {
-                    true
-                }
-            }
-            _ => true,
-        };
-        (self.last_good_q8, bad || !self.seen)
-    }
-}
-
 /// Mutable state of the compensation.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ThermalComp {
-    a: Sensor,
-    b: Sensor,
-    case: Sensor,
-    prev_dt_q8: Option<i32>,
-    grad_q32: i64,
+    a: SensorHold,
+    b: SensorHold,
+    case: SensorHold,
+    grad: Derivative,
     warm_q30: i64,
     bias_q16: i64,
     flags: u8,
@@ -170,23 +130,16 @@ impl ThermalComp {
             | bit(cfg.coeffs_default, flags::COEFFS_DEFAULT);
 
         let dt = ((ta - tb) as i64).clamp(-32 * 256, 32 * 256); // Q8
-                                                                // Differentiator input: 0 while either monoblock sensor is bad (held
-                                                                // values carry no rate), so the gradient decays instead of jumping.
-        const SLOPE_LIMIT_Q32: i64 = 8 << 32;
-        let slope_q32 = match self.prev_dt_q8 {
-            Some(p) if !(bad_a || bad_b) => ((dt - p as i64) * cfg.inv_dt_q16) << 8,
-            _ => 0,
-        }
-        .clamp(-SLOPE_LIMIT_Q32, SLOPE_LIMIT_Q32);
-        self.prev_dt_q8 = Some(dt as i32);
-        // |slope - grad| < 2^36, a < 2^26 (dt <= 1 s): below 2^62. Rounded shifts.
+                                                                // Held values carry no rate: the gradient decays while either
+                                                                // monoblock sensor is bad.
+        let grad_q32 = self.grad.update(&cfg.grad, dt as i32, !(bad_a || bad_b));
+        // |1 - F| <= 2^30, a < 2^26: below 2^56. Rounded shift.
         const HALF: i64 = 1 << 29;
-        self.grad_q32 += ((slope_q32 - self.grad_q32) * cfg.grad_a_q30 + HALF) >> 30;
         self.warm_q30 += (((1i64 << 30) - self.warm_q30) * cfg.warm_a_q30 + HALF) >> 30;
 
         let b = (cfg.bias0_q24 >> 8)
             + ((cfg.k1_q24 * dt) >> 16)
-            + ((cfg.k2_q24 * (self.grad_q32 >> 12)) >> 28)
+            + ((cfg.k2_q24 * (grad_q32 >> 12)) >> 28)
             + ((cfg.k3_q24 * (dt * dt)) >> 24)
             + ((cfg.k4_q24 * tk as i64) >> 16)
             + ((cfg.k5_q24 * (self.warm_q30 >> 6)) >> 32);
@@ -208,11 +161,7 @@ impl ThermalComp {
 
     /// Sensor values in use (last good), Q8 degC: mono A, mono B, case.
     pub fn in_use_q8(&self) -> [i32; 3] {
-        [
-            self.a.last_good_q8,
-            self.b.last_good_q8,
-            self.case.last_good_q8,
-        ]
+        [self.a.value_q8(), self.b.value_q8(), self.case.value_q8()]
     }
 
     /// Last B_TC, Q16 deg/h.
@@ -225,6 +174,6 @@ impl ThermalComp {
     }
     /// Filtered d(dT)/dt, Q32 degC/s.
     pub fn gradient_q32(&self) -> i64 {
-        self.grad_q32
+        self.grad.value_q32()
     }
 }

@@ -12,6 +12,11 @@ pub struct FogRig<F> {
     pub fog: FogLoop,
     pub optics: FogOptics<F>,
     pub profile: Profile<F>,
+    /// The coil's true scale-factor error (relative) and bias (rad/s) at
+    /// its present temperature (`sim::fog_thermal`); 0 by default. The
+    /// Sagnac phase is `K_s * ((1 + scale_error) * rate + bias)`.
+    pub scale_error: F,
+    pub bias_rad_s: F,
     k_sagnac: F,
     step_index: u64,
     /// DAC buffers: [0] is applied this step and receives the closure's new
@@ -49,6 +54,8 @@ where
             fog,
             optics: FogOptics::new(optics),
             profile,
+            scale_error: F::zero(),
+            bias_rad_s: F::zero(),
             step_index: 0,
             dac,
             adc: [0; MAX_HALF * MAX_SAMPLES_PER_HALF],
@@ -75,12 +82,14 @@ where
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
         let half = F::from(0.5).unwrap_or(F::zero());
         let first = self.step_index * n as u64;
+        let gain = self.k_sagnac * (F::one() + self.scale_error);
+        let offset = self.k_sagnac * self.bias_rad_s;
         let mut sum = F::zero();
         for (j, s) in self.sagnac.iter_mut().take(n).enumerate() {
             let t = (F::from(first + j as u64).unwrap_or(F::zero()) + half) * tau;
             let rate = self.profile.rate_at(t);
             sum = sum + rate;
-            *s = self.k_sagnac * rate;
+            *s = gain * rate + offset;
         }
         let ns = self.cfg.n_samples;
         let (dac, adc, sagnac) = (&self.dac[0][..n], &mut self.adc[..ns], &self.sagnac[..n]);

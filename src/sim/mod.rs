@@ -5,10 +5,14 @@
 
 pub mod fog_optics;
 pub mod fog_rig;
+pub mod fog_thermal;
+pub mod noise;
 pub mod profile;
 pub mod rlg_rig;
 
 pub use fog_optics::{FogOptics, OpticsParams};
 pub use fog_rig::FogRig;
+pub use fog_thermal::{CoilThermal, ScaleFactorTruth};
+pub use noise::{NoiseParams, RateNoise};
 pub use profile::{Profile, Segment};
 pub use rlg_rig::{Chamber, ChamberParams, ChamberSample};

@@ -1,6 +1,7 @@
 //! Decoding of the firmware's UART frames into a run file, and the summary.
 
 use anyhow::{Context, Result};
+use gyro_sp::fog::scale_factor::flags as sf_flags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
 use gyro_sp::rlg::thermal::flags as rlg_flags;
@@ -15,8 +16,11 @@ const DPH: f64 = 3600.0 / DEG;
 pub struct Row {
     pub t_s: f64,
     pub ref_rate: f64,
+    /// FOG rate, rad/s: eps^2-corrected (nominal scale factor), uncorrected,
+    /// and compensated over temperature (the final output).
     pub rate: f64,
     pub rate_raw: f64,
+    pub rate_comp: f64,
     /// RLG: compensated rate and counts-only rate, deg/s.
     pub rlg_rate_dps: f64,
     pub rlg_rate_raw_dps: f64,
@@ -92,6 +96,7 @@ pub fn analyse(path: &Path) -> Result<Report> {
                     ref_rate: truth / halves,
                     rate: f.fog_angle as f64 * lsb / halves,
                     rate_raw: f.fog_angle_raw as f64 * lsb / halves,
+                    rate_comp: f.fog_angle_comp as f64 * lsb / halves,
                     frame: f,
                     segment,
                     t_in_segment: t_mid - seg_starts[segment],
@@ -150,16 +155,23 @@ pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
     )?;
     writeln!(
         w,
-        "t_s,ref_rate_dps,rate_dps,rate_raw_dps,faults,seq,dc_lsb,codes_per_turn"
+        "t_s,ref_rate_dps,rate_dps,rate_raw_dps,rate_comp_dps,temp_c,t_coil_c,sf_corr_ppm,fog_bias_dph,fog_temp_flags,faults,seq,dc_lsb,codes_per_turn"
     )?;
     for row in &r.rows {
+        let th = &row.frame.fog_temp;
         writeln!(
             w,
-            "{:.6},{:.9},{:.9},{:.9},{},{},{},{:.4}",
+            "{:.6},{:.9},{:.9},{:.9},{:.9},{:.4},{:.4},{:.4},{:.5},{},{},{},{},{:.4}",
             row.t_s,
             row.ref_rate / DEG,
             row.rate / DEG,
             row.rate_raw / DEG,
+            row.rate_comp / DEG,
+            th.t_sensor_q8 as f64 / 256.0,
+            th.t_coil_q8 as f64 / 256.0,
+            th.sf_corr_q32 as f64 / 4_294_967_296.0 * 1e6,
+            th.bias_q16_dph as f64 / 65_536.0,
+            th.flags,
             row.frame.faults,
             row.frame.seq,
             row.frame.dc,
@@ -169,13 +181,19 @@ pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Per segment: mean and RMS of output minus truth (deg/h) after 20 ms settling.
+/// Per segment, after 20 ms settling: mean and RMS of the final output
+/// (compensated over temperature) minus truth, deg/h; the mean of the
+/// eps^2-corrected output before the temperature compensation and of the
+/// uncorrected one; the scale-factor error before and after the
+/// compensation, ppm (segments at a constant nonzero rate).
 pub struct SegmentStats {
     pub name: &'static str,
     pub frames: usize,
     pub mean_dph: f64,
     pub rms_dph: f64,
+    pub mean_nocomp_dph: f64,
     pub mean_raw_dph: f64,
+    pub sf_ppm: Option<(f64, f64)>,
     pub faults: u16,
 }
 
@@ -188,20 +206,27 @@ pub fn segment_stats(r: &Report) -> Vec<SegmentStats> {
                 .filter(|x| x.segment == s && x.t_in_segment > 0.02)
                 .collect();
             let n = rows.len().max(1) as f64;
-            let mean = rows.iter().map(|x| x.rate - x.ref_rate).sum::<f64>() / n;
-            let raw = rows.iter().map(|x| x.rate_raw - x.ref_rate).sum::<f64>() / n;
-            let rms = (rows
-                .iter()
-                .map(|x| (x.rate - x.ref_rate).powi(2))
-                .sum::<f64>()
-                / n)
-                .sqrt();
+            let mean_of = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|x| f(x)).sum::<f64>() / n;
+            let mean = mean_of(&|x| x.rate_comp - x.ref_rate);
+            let rms = mean_of(&|x| (x.rate_comp - x.ref_rate).powi(2)).sqrt();
+            let constant = rows.len() > 1
+                && rows
+                    .iter()
+                    .all(|x| (x.ref_rate - rows[0].ref_rate).abs() < 1e-9)
+                && rows[0].ref_rate.abs() > 1.0 * DEG;
             SegmentStats {
                 name: r.segment_names[s],
                 frames: rows.len(),
                 mean_dph: mean * DPH,
                 rms_dph: rms * DPH,
-                mean_raw_dph: raw * DPH,
+                mean_nocomp_dph: mean_of(&|x| x.rate - x.ref_rate) * DPH,
+                mean_raw_dph: mean_of(&|x| x.rate_raw - x.ref_rate) * DPH,
+                sf_ppm: constant.then(|| {
+                    (
+                        mean_of(&|x| x.rate / x.ref_rate - 1.0) * 1e6,
+                        mean_of(&|x| x.rate_comp / x.ref_rate - 1.0) * 1e6,
+                    )
+                }),
                 faults: r
                     .rows
                     .iter()
@@ -221,15 +246,37 @@ pub fn print_summary(r: &Report) {
         r.step_gaps
     );
     println!(
-        "{:<28} {:>6} {:>14} {:>14} {:>16}  faults",
-        "segment", "frames", "mean err deg/h", "rms err deg/h", "uncorrected deg/h"
+        "{:<28} {:>6} {:>14} {:>14} {:>16} {:>17} {:>22}  faults",
+        "segment",
+        "frames",
+        "mean err deg/h",
+        "rms err deg/h",
+        "no temp comp",
+        "no eps^2 corr",
+        "scale factor ppm"
     );
     for s in segment_stats(r) {
+        let sf = s
+            .sf_ppm
+            .map_or(String::from("-"), |(b, a)| format!("{b:+.2} -> {a:+.3}"));
         println!(
-            "{:<28} {:>6} {:>14.4} {:>14.3} {:>16.4}  {:#06x}",
-            s.name, s.frames, s.mean_dph, s.rms_dph, s.mean_raw_dph, s.faults
+            "{:<28} {:>6} {:>14.4} {:>14.3} {:>16.4} {:>17.4} {:>22}  {:#06x}",
+            s.name,
+            s.frames,
+            s.mean_dph,
+            s.rms_dph,
+            s.mean_nocomp_dph,
+            s.mean_raw_dph,
+            sf,
+            s.faults
         );
     }
+    let th = fog_temp_stats(r);
+    println!(
+        "FOG temperature: coil {:.2} -> {:.2} degC (table input; the simulated coil's knee at 48 degC, \
+         calibrated to 60 degC); scale-factor error before -> after compensation in ppm above; flags seen {:#04x}",
+        th.first_coil_c, th.last_coil_c, th.flags_seen
+    );
     let eps = 50_000.0 * DEG;
     let pred = r.cfg.predicted_vibration_drift(eps * eps / 2.0) * DPH;
     println!("vibration drift formula (-(1/4) cot(phi0) K_s <eps^2> dt_m dt_p): {pred:.4} deg/h");
@@ -239,6 +286,21 @@ pub fn print_summary(r: &Report) {
          temperatures {:.3}/{:.3}/{:.3} degC (mono A/B, case); flags seen {:#04x}",
         g.angle_deg, g.counts, g.truth_deg, g.error_counts, g.bias_dph, g.temps[0], g.temps[1], g.temps[2], g.flags_seen
     );
+}
+
+pub struct FogTempStats {
+    pub first_coil_c: f64,
+    pub last_coil_c: f64,
+    pub flags_seen: u8,
+}
+
+pub fn fog_temp_stats(r: &Report) -> FogTempStats {
+    let coil = |x: Option<&Row>| x.map_or(f64::NAN, |x| x.frame.fog_temp.t_coil_q8 as f64 / 256.0);
+    FogTempStats {
+        first_coil_c: coil(r.rows.first()),
+        last_coil_c: coil(r.rows.last()),
+        flags_seen: r.rows.iter().fold(0, |a, x| a | x.frame.fog_temp.flags),
+    }
 }
 
 pub struct RlgStats {
@@ -316,6 +378,36 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
         let ok = s.mean_dph.abs() < 1.0 && s.faults & Faults::OUT_OF_LOCK == 0;
         v.push(("locked", ok, format!("{}: {:.4} deg/h", s.name, s.mean_dph)));
     }
+    // The scale factor over temperature: each constant-rate segment's error
+    // shrinks from the coil's hundreds of ppm to under 2 ppm; the coil
+    // sensor answers (its flag is up only for the first frame, before a
+    // read), the table loads, and the sweep beyond 60 degC is flagged as
+    // outside the calibrated range.
+    for s in stats.iter().filter(|s| s.sf_ppm.is_some()) {
+        let (before, after) = s.sf_ppm.unwrap_or_default();
+        v.push((
+            "scale_factor_compensated",
+            after.abs() < 2.0 && before.abs() > 50.0,
+            format!("{}: {before:+.2} ppm -> {after:+.3} ppm", s.name),
+        ));
+    }
+    let th = fog_temp_stats(r);
+    let sensor_flagged = r
+        .rows
+        .iter()
+        .skip(1)
+        .filter(|x| {
+            x.frame.fog_temp.flags & (sf_flags::COIL_SENSOR | sf_flags::COEFFS_REFUSED) != 0
+        })
+        .count();
+    v.push((
+        "fog_coil_sensor_and_table",
+        sensor_flagged == 0 && th.last_coil_c > 60.0 && th.flags_seen & sf_flags::OUT_OF_RANGE != 0,
+        format!(
+            "{sensor_flagged} frames flagged after the first; coil {:.2} -> {:.2} degC; flags seen {:#04x}",
+            th.first_coil_c, th.last_coil_c, th.flags_seen
+        ),
+    ));
     let vib = stats.iter().find(|s| s.name.starts_with("vibration"));
     if let Some(s) = vib {
         let ok = s.mean_dph.abs() < 0.1 * s.mean_raw_dph.abs();

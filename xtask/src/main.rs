@@ -195,24 +195,26 @@ fn test_cmd() -> Result<()> {
 fn bench_cmd() -> Result<()> {
     setup::ensure_all()?;
     let qrun = run_qemu()?;
-    let grab = |key: &str| -> Option<u64> {
-        let line = qrun.log.lines().find(|l| l.contains("bench:"))?;
-        let v = line
-            .split_whitespace()
-            .find_map(|w| w.strip_prefix(&format!("{key}=")))?;
-        v.trim().parse().ok()
-    };
-    let instr = grab("fog_closure_instructions").context("no bench line in the firmware log")?;
-    let stack = grab("stack_bytes").context("no stack figure in the firmware log")?;
-    let rlg_instr = qrun
+    // key=value words of the firmware's `bench:` log lines.
+    let figures: std::collections::HashMap<&str, u64> = qrun
         .log
         .lines()
-        .find_map(|l| {
-            l.split_whitespace()
-                .find_map(|w| w.strip_prefix("rlg_update_instructions="))
-                .and_then(|v| v.trim().parse::<u64>().ok())
+        .filter(|l| l.contains("bench:"))
+        .flat_map(|l| l.split_whitespace())
+        .filter_map(|w| {
+            let (k, v) = w.split_once('=')?;
+            Some((k, v.trim().parse().ok()?))
         })
-        .context("no RLG bench line in the firmware log")?;
+        .collect();
+    let grab = |key: &str| {
+        figures
+            .get(key)
+            .copied()
+            .with_context(|| format!("no {key} in the firmware's bench lines"))
+    };
+    let instr = grab("fog_closure_instructions")?;
+    let stack = grab("stack_bytes")?;
+    let rlg_instr = grab("rlg_update_instructions")?;
     let (flash, ram) = frames::elf_sizes(&qrun.elf)?;
     // Real-time factor of the host simulator (release build, default options).
     run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
@@ -227,8 +229,11 @@ fn bench_cmd() -> Result<()> {
         .context("no realtime_factor from gyro-lab")?;
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
-        "fog_closure_instructions_max": grab("max"),
+        "fog_closure_instructions_max": grab("max")?,
         "rlg_update_instructions": rlg_instr,
+        "fog_sf_frame_instructions": grab("fog_sf_frame_instructions")?,
+        "fog_sf_frame_instructions_max": grab("sf_frame_max")?,
+        "fog_sf_sensor_instructions": grab("fog_sf_sensor_instructions")?,
         "sim_fog_realtime_factor": (rtf * 10.0).round() / 10.0,
         "flash_bytes": flash,
         "ram_bytes": ram,

@@ -10,7 +10,6 @@
 
 use gyro_sp::rlg::thermal::GRAD_TAU_S;
 use gyro_sp::rlg::ThermalCoeffs;
-use nalgebra::{DMatrix, DVector};
 
 /// Inputs of a fit, one row per sample.
 pub struct ThermalData {
@@ -41,28 +40,9 @@ pub fn dt_and_gradient(d: &ThermalData) -> (Vec<f64>, Vec<f64>) {
     (dts, grads)
 }
 
-/// Least squares with columns scaled to unit RMS; returns the coefficients
-/// and the residual.
+/// Least squares: the coefficients and the residual.
 fn lstsq(cols: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
-    let n = y.len();
-    let m = cols.len();
-    let scale: Vec<f64> = cols
-        .iter()
-        .map(|c| {
-            let r = (c.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-            if r > 0.0 {
-                r
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let x = DMatrix::from_fn(n, m, |i, j| cols[j][i] / scale[j]);
-    let yv = DVector::from_column_slice(y);
-    let sol = x.clone().svd(true, true).solve(&yv, 1e-12).ok()?;
-    let res = &yv - &x * &sol;
-    let coef = (0..m).map(|j| sol[j] / scale[j]).collect();
-    Some((coef, res.iter().copied().collect()))
+    crate::lsq::wls(cols, y, None).map(|f| (f.coef, f.resid))
 }
 
 fn sse(r: &[f64]) -> f64 {

@@ -6,8 +6,8 @@ pub mod fit;
 use crate::error::LabError;
 use crate::table::Table;
 use clap::Args;
-use coeff_file::{CoeffFile, RlgThermal};
 use fit::{fit_thermal, noise_floor_100s, std_of_means, CubicModel, ThermalData};
+use gyro_coeffs::file::CoeffFile;
 use gyro_sp::rlg::thermal::{Temperatures, ThermalComp, ThermalConfig};
 use gyro_sp::rlg::{compensate_rate_ndps, ThermalCoeffs};
 use std::path::{Path, PathBuf};
@@ -37,14 +37,6 @@ pub fn read_run(path: &Path) -> Result<(Table, ThermalData, Vec<f64>), LabError>
         },
         rate,
     ))
-}
-
-pub fn to_coeffs(c: &RlgThermal) -> ThermalCoeffs {
-    ThermalCoeffs::from_values(c.values())
-}
-
-pub fn from_coeffs(c: &ThermalCoeffs) -> RlgThermal {
-    RlgThermal::from_values(c.values())
 }
 
 /// B_TC per row by the firmware's own fixed-point compensation (thermal.rs),
@@ -92,7 +84,7 @@ pub struct FitThermalArgs {
 
 #[derive(Debug, serde::Serialize)]
 pub struct FitSummary {
-    pub coefficients: RlgThermal,
+    pub coefficients: ThermalCoeffs,
     /// Standard deviation of 100 s means, deg/h: raw drift, after the
     /// improved model (float fit), after the classic one-sensor cubic.
     pub raw_std_100s_dph: f64,
@@ -124,7 +116,7 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
         .zip(&d.a)
         .map(|(y, t)| y - cubic.eval(*t))
         .collect();
-    let coefficients = from_coeffs(&c);
+    let coefficients = c;
     let s = FitSummary {
         coefficients,
         raw_std_100s_dph: std_of_means(&d.t, &d.drift_dph, 100.0),
@@ -146,23 +138,10 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
     }
     info.insert(
         "record_crc32".into(),
-        format!(
-            "0x{:08x}",
-            u32::from_le_bytes(
-                c.to_record()[gyro_sp::rlg::coeffs::RECORD_LEN - 4..]
-                    .try_into()
-                    .unwrap_or([0; 4])
-            )
-        )
-        .into(),
+        format!("0x{:08x}", gyro_coeffs::record::crc_of(&c.to_record())).into(),
     );
-    let file = CoeffFile {
-        kind: "rlg_thermal".into(),
-        version: coeff_file::VERSION,
-        rlg_thermal: Some(coefficients),
-        fit: Some(info),
-    };
-    coeff_file::write(
+    let file = CoeffFile::rlg_thermal(coefficients, info);
+    gyro_coeffs::file::write(
         &a.out,
         &file,
         "RLG thermal bias model (physics.md 2.3), written by gyro-lab fit thermal.\n\
@@ -215,15 +194,17 @@ pub struct CompensateSummary {
     pub sensor_flags_seen: u8,
 }
 
+/// `gyro-lab compensate`: either kind of coefficient file, by its `kind`.
 pub fn compensate_run(a: &CompensateArgs) -> Result<(), LabError> {
-    let file = coeff_file::read(&a.coeffs).map_err(LabError::Input)?;
-    let Some(ct) = file.rlg_thermal else {
-        return Err(LabError::Input(format!(
-            "{}: no coefficients",
-            a.coeffs.display()
-        )));
-    };
-    let c = to_coeffs(&ct);
+    let (_, coeffs) = gyro_coeffs::file::read(&a.coeffs).map_err(LabError::Input)?;
+    match coeffs {
+        gyro_coeffs::file::Coeffs::RlgThermal(c) => compensate_rlg(a, &c),
+        gyro_coeffs::file::Coeffs::FogScaleFactor(t) => crate::scale_factor::compensate_run(a, &t),
+    }
+}
+
+fn compensate_rlg(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
+    let c = *c;
     let (tab, d, rate) = read_run(&a.data)?;
     let (bias, flags) = firmware_bias(&c, &d);
     let comp: Vec<f64> = rate
