@@ -205,16 +205,15 @@ pub fn run() -> ! {
     if fog_thermal.cfg.coeffs_refused {
         defmt::warn!("FOG scale-factor record refused: running without temperature compensation");
     }
-    let mut rig = FogRig::new(cfg, optics, profile);
-    set_fog_truth(&mut rig, &fog_thermal.truth, 0.5 / RLG_HZ as f64);
     let bench = || Bench {
         ticks_sum: 0,
         ticks_max: 0,
         n: 0,
     };
     cortex_m::interrupt::free(|cs| {
+        // The rig (2.6 kB) is built in place, not moved in from a local.
         CTX.borrow(cs).replace(Some(Ctx {
-            rig,
+            rig: FogRig::new(cfg, optics, profile),
             rlg,
             rlg_bench: bench(),
             fog_thermal,
@@ -225,7 +224,10 @@ pub fn run() -> ! {
             counter: 0,
             total,
             bench: bench(),
-        }))
+        }));
+        if let Some(c) = CTX.borrow(cs).borrow_mut().as_mut() {
+            set_fog_truth(&mut c.rig, &c.fog_thermal.truth, 0.5 / RLG_HZ as f64);
+        }
     });
     defmt::info!(
         "gyro-fw qemu: FOG closure at {} Hz, {} steps, frames every {} steps",
