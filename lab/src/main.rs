@@ -3,7 +3,7 @@
 //! error naming the file, line and column.
 
 use gyro_lab::error::LabError;
-use gyro_lab::{lockin, scale_factor, simulate, thermal};
+use gyro_lab::{allan, lockin, scale_factor, simulate, thermal};
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -30,6 +30,8 @@ enum Cmd {
     /// Calibration fits on test-rig runs.
     #[command(subcommand)]
     Fit(FitCmd),
+    /// Noise analysis: overlapping Allan deviation, IEEE 952 terms with intervals.
+    Allan(allan::AllanArgs),
     /// Apply a coefficient file as the firmware does; adds `rate_comp_dps`.
     Compensate(thermal::CompensateArgs),
     /// Benchmarks of the estimators on simulated records.
@@ -51,9 +53,21 @@ enum BenchCmd {
     Lockin(lockin::LockinBenchArgs),
     /// FOG scale factor: raw, classic multi-point and continuous rotation on one simulated gyro.
     ScaleFactor(scale_factor::bench::BenchArgs),
+    /// Allan terms recovered from the project's noise generators, over seeds.
+    Allan(allan::bench::AllanBenchArgs),
+    /// Allan analysis time on 10^7 samples against the O(N m) definition.
+    AllanSpeed(allan::bench::SpeedArgs),
 }
 
 fn main() -> ExitCode {
+    // Output piped into `head` and closed early: end quietly as other Unix
+    // tools do, not with a panic on the broken pipe.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of one signal at start,
+    // before any thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -68,8 +82,11 @@ fn main() -> ExitCode {
         Cmd::Fit(FitCmd::Thermal(a)) => thermal::fit_run(&a),
         Cmd::Fit(FitCmd::ScaleFactor(a)) => scale_factor::fit_run(&a),
         Cmd::Compensate(a) => thermal::compensate_run(&a),
+        Cmd::Allan(a) => allan::run(&a),
         Cmd::Bench(BenchCmd::Lockin(a)) => lockin::bench_run(&a),
         Cmd::Bench(BenchCmd::ScaleFactor(a)) => scale_factor::bench::run(&a),
+        Cmd::Bench(BenchCmd::Allan(a)) => allan::bench::run(&a),
+        Cmd::Bench(BenchCmd::AllanSpeed(a)) => allan::bench::speed(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -81,7 +81,13 @@ pub struct FogArgs {
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FogSummary {
     pub mean_error_dph: f64,
+    /// Standard error of `mean_error_dph` from the output's own noise: the
+    /// Allan deviation, at the averaging time, of the noise model fitted to
+    /// the error's batch means (whole oscillation periods each), which holds
+    /// for correlated noise (the slow AGC); null under 3 batches.
+    pub mean_error_stderr_dph: Option<f64>,
     pub mean_error_raw_dph: f64,
+    pub mean_error_raw_stderr_dph: Option<f64>,
     pub predicted_drift_dph: f64,
     pub duration_s: f64,
     pub averaged_s: f64,
@@ -105,8 +111,33 @@ pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
                     serde_json::to_string(&s).map_err(|e| LabError::Io(e.to_string()))?
                 );
             } else {
-                println!("mean error: {:+.6} deg/h corrected, {:+.6} deg/h raw (formula drift {:+.6} deg/h)",
-                    s.mean_error_dph, s.mean_error_raw_dph, s.predicted_drift_dph);
+                let pm = |v: f64, se: Option<f64>| match se {
+                    Some(se) => format!("{v:+.6} +- {se:.6}"),
+                    None => format!("{v:+.6} (standard error unknown: under 2 batches)"),
+                };
+                println!(
+                    "mean error: {} deg/h corrected, {} deg/h raw (formula drift {:+.6} deg/h)",
+                    pm(s.mean_error_dph, s.mean_error_stderr_dph),
+                    pm(s.mean_error_raw_dph, s.mean_error_raw_stderr_dph),
+                    s.predicted_drift_dph
+                );
+                for (what, v, se) in [
+                    ("corrected", s.mean_error_dph, s.mean_error_stderr_dph),
+                    ("raw", s.mean_error_raw_dph, s.mean_error_raw_stderr_dph),
+                ] {
+                    if let Some(se) = se {
+                        if se > 0.1 * v.abs() && v != 0.0 {
+                            // The standard error falls as 1/sqrt(T).
+                            let need = s.averaged_s * (se / (0.1 * v.abs())).powi(2);
+                            println!(
+                                "note: the {what} mean is still uncertain (standard error {:.0} % of it); \
+                                 about --duration-s {:.0} brings it to 10 %",
+                                100.0 * se / v.abs(),
+                                need.ceil() + (s.duration_s - s.averaged_s)
+                            );
+                        }
+                    }
+                }
                 println!(
                     "{} steps, {:.3} s simulated in {:.2} s ({:.0}x real time)",
                     s.steps, s.duration_s, s.wall_s, s.realtime_factor
@@ -196,6 +227,15 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
         None => steps - settle_steps,
     };
     let start_avg = steps - avg_steps;
+    // Batches for the standard error: whole oscillation periods (else 25
+    // steps, a frame), at most about 10^6 of them.
+    let batch_steps = {
+        let per = period.map_or(25.0, |p| p / dt);
+        let whole = (avg_steps as f64 / 1e6 / per).ceil().max(1.0);
+        (whole * per).round().max(1.0) as u64
+    };
+    let mut batches: Vec<(f64, f64)> = Vec::new();
+    let (mut b_err, mut b_raw, mut b_n) = (0.0f64, 0.0f64, 0u64);
 
     let mut rig = FogRig::new(cfg, optics, profile);
     let lsb_rate = cfg.rad_s_per_step_lsb();
@@ -236,6 +276,13 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
         if k >= start_avg {
             err_sum += out - r.true_rate;
             raw_sum += raw - r.true_rate;
+            b_err += out - r.true_rate;
+            b_raw += raw - r.true_rate;
+            b_n += 1;
+            if b_n == batch_steps {
+                batches.push((b_err / b_n as f64, b_raw / b_n as f64));
+                (b_err, b_raw, b_n) = (0.0, 0.0, 0);
+            }
         }
         faults_seen |= r.out.faults.0;
         last_cpt = r.out.codes_per_turn_q8;
@@ -272,9 +319,18 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
         w.flush()?;
     }
     let n = avg_steps.max(1) as f64;
+    let batch_s = batch_steps as f64 * dt;
+    let se = |f: fn(&(f64, f64)) -> f64| {
+        let v: Vec<f64> = batches.iter().map(f).collect();
+        crate::allan::analyse(&v, batch_s)
+            .ok()
+            .map(|a| a.mean_se_dps * DPH_PER_RAD_S)
+    };
     Ok(FogSummary {
         mean_error_dph: err_sum / n * DPH_PER_RAD_S,
+        mean_error_stderr_dph: se(|b| b.0),
         mean_error_raw_dph: raw_sum / n * DPH_PER_RAD_S,
+        mean_error_raw_stderr_dph: se(|b| b.1),
         predicted_drift_dph: predicted,
         duration_s: steps as f64 * dt,
         averaged_s: avg_steps as f64 * dt,

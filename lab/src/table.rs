@@ -188,3 +188,101 @@ impl Table {
             .map_err(|e| LabError::Io(format!("{}: {e}", out.display())))
     }
 }
+
+/// Numeric columns of a long record, read in one pass without keeping the
+/// text (a 10^7-row run file as a [`Table`] would be gigabytes of strings).
+/// The same checks and messages as [`Table`]: a missing column, an empty or
+/// non-numeric cell, NaN or infinity give `file:line:column`.
+pub struct Columns {
+    pub path: PathBuf,
+    pub header_line: u64,
+    /// One vector per requested column, in the order asked.
+    pub data: Vec<Vec<f64>>,
+    /// File line of every row.
+    pub lines: Vec<u64>,
+    /// 1-based field number of every requested column.
+    pub fields: Vec<usize>,
+}
+
+impl Columns {
+    pub fn read(path: &Path, cols: &[&str]) -> Result<Self, LabError> {
+        let name = path.display().to_string();
+        let file = std::fs::File::open(path)
+            .map_err(|e| LabError::Input(format!("{name}: cannot read: {e}")))?;
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .buffer_capacity(1 << 20)
+            .from_reader(std::io::BufReader::with_capacity(1 << 20, file));
+        let mut rec = csv::ByteRecord::new();
+        let at = |e: csv::Error| {
+            let line = e.position().map_or(0, |p| p.line());
+            LabError::Input(format!("{name}:{line}: {e}"))
+        };
+        if !rdr.read_byte_record(&mut rec).map_err(at)? {
+            return Err(LabError::Input(format!("{name}: no header row")));
+        }
+        let header_line = rec.position().map_or(1, |p| p.line());
+        let header: Vec<String> = rec
+            .iter()
+            .map(|f| String::from_utf8_lossy(f).into_owned())
+            .collect();
+        let mut fields = Vec::new();
+        for c in cols {
+            let i = header.iter().position(|h| h == c).ok_or_else(|| {
+                LabError::Input(format!("{name}:{header_line}: missing column `{c}`"))
+            })?;
+            fields.push(i + 1);
+        }
+        let mut data: Vec<Vec<f64>> = cols.iter().map(|_| Vec::new()).collect();
+        let mut lines = Vec::new();
+        while rdr.read_byte_record(&mut rec).map_err(at)? {
+            let line = rec.position().map_or(0, |p| p.line());
+            if rec.iter().all(|f| f.is_empty()) {
+                continue;
+            }
+            for (k, &f) in fields.iter().enumerate() {
+                let cell = rec.get(f - 1).unwrap_or(b"");
+                let text = std::str::from_utf8(cell).unwrap_or("");
+                let v = match text.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    Ok(_) => Err(format!("`{text}` is not a finite number")),
+                    Err(_) if text.is_empty() => Err("empty cell".to_owned()),
+                    Err(_) => Err(format!("cannot read `{text}` as a number")),
+                }
+                .map_err(|m| {
+                    LabError::Input(format!("{name}:{line}:{f} (column `{}`): {m}", cols[k]))
+                })?;
+                data[k].push(v);
+            }
+            lines.push(line);
+        }
+        Ok(Self {
+            path: path.to_owned(),
+            header_line,
+            data,
+            lines,
+            fields,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// `file:line:column (column `name`)` of row `row` in requested column `k`.
+    pub fn place(&self, row: usize, k: usize, col: &str) -> String {
+        let line = self.lines.get(row).copied().unwrap_or(self.header_line);
+        format!(
+            "{}:{line}:{} (column `{col}`)",
+            self.path.display(),
+            self.fields[k]
+        )
+    }
+}

@@ -10,12 +10,16 @@
 //! | rate ramp | `r_dps2` (R, deg/s^2) | R^2 tau^2 / 2 |
 //!
 //! Each sample is the mean rate over one sample period dt (what a gyro's
-//! angle increments give), so white noise has sigma N/sqrt(dt) and the
-//! quantization is that of the accumulated angle. Flicker noise (PSD
-//! B^2/(2 pi f)) is a sum of first-order Gauss-Markov processes with
-//! correlation times spaced by 10^(1/3) from dt to `flicker_max_tau_s`:
-//! a sum of Lorentzians of equal variance sigma^2 spaced by r has the PSD
-//! sigma^2/(2 f ln r), so sigma^2 = B^2 ln(r)/pi.
+//! angle increments give), so white noise has sigma N/sqrt(dt). Angle
+//! quantization is the white angle error a quantizer leaves when the angle
+//! crosses many quanta per sample (or is dithered): uniform, of width
+//! S = Q sqrt(12), independent from sample to sample. Flicker noise
+//! (two-sided PSD B^2/(2 pi f), IEEE 952) is a sum of Ornstein-Uhlenbeck
+//! processes with correlation times spaced by r = 10^(1/3) from dt/1000 to
+//! `flicker_max_tau_s`: Lorentzians of equal variance sigma^2 spaced by r
+//! sum to sigma^2/(2 f ln r), so sigma^2 = B^2 ln(r)/pi. Each process is
+//! advanced exactly and its exact mean over the period drawn jointly with
+//! its end value, so the floor is flat down to tau = dt.
 
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
@@ -23,8 +27,8 @@ use rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-/// Most Gauss-Markov processes of the flicker sum (3 per decade: 8 decades).
-pub const MAX_FLICKER: usize = 24;
+/// Most processes of the flicker sum (3 per decade: 16 decades).
+pub const MAX_FLICKER: usize = 48;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NoiseParams {
@@ -58,16 +62,18 @@ pub struct RateNoise {
     p: NoiseParams,
     dt: f64,
     rng: Xoshiro256PlusPlus,
-    /// Flicker: AR(1) states, their coefficients phi and innovation sigmas.
+    /// Flicker: the processes' states, their step coefficient phi, the
+    /// mean's dependence on the start (T/dt (1 - phi)) and the Cholesky
+    /// factor of the (end, mean) innovations.
     fl_x: [f64; MAX_FLICKER],
     fl_phi: [f64; MAX_FLICKER],
-    fl_sig: [f64; MAX_FLICKER],
+    fl_g: [f64; MAX_FLICKER],
+    fl_l: [[f64; 3]; MAX_FLICKER],
     fl_n: usize,
+    /// Last angle-quantization error, deg.
+    q_prev: f64,
     rrw: f64,
     t: f64,
-    /// Angle since start without and with quantization, deg.
-    angle: f64,
-    angle_q: f64,
 }
 
 impl RateNoise {
@@ -80,22 +86,36 @@ impl RateNoise {
             rng: Xoshiro256PlusPlus::seed_from_u64(0),
             fl_x: [0.0; MAX_FLICKER],
             fl_phi: [0.0; MAX_FLICKER],
-            fl_sig: [0.0; MAX_FLICKER],
+            fl_g: [0.0; MAX_FLICKER],
+            fl_l: [[0.0; 3]; MAX_FLICKER],
             fl_n: 0,
+            q_prev: 0.0,
             rrw: 0.0,
             t: 0.0,
-            angle: 0.0,
-            angle_q: 0.0,
         };
         if p.b_dps > 0.0 {
             let r: f64 = 10f64.powf(1.0 / 3.0);
             let var = p.b_dps * p.b_dps * r.ln() / core::f64::consts::PI;
-            let mut tau = dt_s;
+            let h = dt_s;
+            let mut tau = dt_s * 1e-3;
             while s.fl_n < MAX_FLICKER && tau <= p.flicker_max_tau_s.max(dt_s) {
-                let phi = (-dt_s / tau).exp();
+                // OU over one period from x0: end = phi x0 + e1, mean =
+                // g x0 + e2, with
+                // var e1 = v (1 - phi^2),
+                // var e2 = v (T/h)^2 (2h/T - 3 + 4 phi - phi^2),
+                // cov = v (T/h) (1 - phi)^2.
+                let phi = (-h / tau).exp();
+                let a = tau / h;
+                let v11 = var * (1.0 - phi * phi);
+                let v22 = var * a * a * (2.0 / a - 3.0 + 4.0 * phi - phi * phi);
+                let v12 = var * a * (1.0 - phi) * (1.0 - phi);
+                let l11 = v11.max(0.0).sqrt();
+                let l21 = if l11 > 0.0 { v12 / l11 } else { 0.0 };
+                let l22 = (v22 - l21 * l21).max(0.0).sqrt();
                 let k = s.fl_n;
                 s.fl_phi[k] = phi;
-                s.fl_sig[k] = (var * (1.0 - phi * phi)).sqrt();
+                s.fl_g[k] = a * (1.0 - phi);
+                s.fl_l[k] = [l11, l21, l22];
                 // Start in the stationary state.
                 let z: f64 = StandardNormal.sample(&mut rng);
                 s.fl_x[k] = var.sqrt() * z;
@@ -117,9 +137,11 @@ impl RateNoise {
         let dt = self.dt;
         let mut rate = p.n_dps_rts / dt.sqrt() * self.normal();
         for k in 0..self.fl_n {
-            let z = self.normal();
-            self.fl_x[k] = self.fl_phi[k] * self.fl_x[k] + self.fl_sig[k] * z;
-            rate += self.fl_x[k];
+            let (z1, z2) = (self.normal(), self.normal());
+            let [l11, l21, l22] = self.fl_l[k];
+            let x0 = self.fl_x[k];
+            rate += self.fl_g[k] * x0 + l21 * z1 + l22 * z2;
+            self.fl_x[k] = self.fl_phi[k] * x0 + l11 * z1;
         }
         // Rate random walk: the mean over the period of a Wiener process
         // (its start plus a step of K*sqrt(dt) whose mean over the period
@@ -133,13 +155,11 @@ impl RateNoise {
         rate += p.r_dps2 * (self.t + 0.5 * dt);
         self.t += dt;
         if p.q_deg > 0.0 {
-            // Quantization of the accumulated angle (quantum S = Q*sqrt(12)).
-            let s = p.q_deg * 12f64.sqrt();
-            self.angle += rate * dt;
-            let q = (self.angle / s).floor() * s;
-            let out = (q - self.angle_q) / dt;
-            self.angle_q = q;
-            return out;
+            // White angle error of variance Q^2: uniform over S = Q sqrt(12).
+            let u: f64 = rand_distr::StandardUniform.sample(&mut self.rng);
+            let e = (u - 0.5) * p.q_deg * 12f64.sqrt();
+            rate += (e - self.q_prev) / dt;
+            self.q_prev = e;
         }
         rate
     }

@@ -227,6 +227,18 @@ fn bench_cmd() -> Result<()> {
     let rtf = v["realtime_factor"]
         .as_f64()
         .context("no realtime_factor from gyro-lab")?;
+    // Allan analysis of 10^7 samples (28 h at 100 Hz), the CSV read of that
+    // record apart, against the O(N m) definition on 10^5.
+    let out = Command::new(&lab)
+        .args(["bench", "allan-speed", "--json"])
+        .output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let allan: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or("{}"))?;
+    let af = |k: &str| {
+        allan[k]
+            .as_f64()
+            .with_context(|| format!("no {k} from gyro-lab bench allan-speed"))
+    };
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
         "fog_closure_instructions_max": grab("max")?,
@@ -235,6 +247,10 @@ fn bench_cmd() -> Result<()> {
         "fog_sf_frame_instructions_max": grab("sf_frame_max")?,
         "fog_sf_sensor_instructions": grab("fog_sf_sensor_instructions")?,
         "sim_fog_realtime_factor": (rtf * 10.0).round() / 10.0,
+        "allan_1e7_s": af("allan_1e7_s")?,
+        "allan_read_1e7_s": af("allan_read_1e7_s")?,
+        "allan_reference_1e5_s": af("allan_reference_1e5_s")?,
+        "allan_1e7_vs_reference_1e5": af("allan_1e7_vs_reference_1e5")?,
         "flash_bytes": flash,
         "ram_bytes": ram,
         "stack_bytes": stack,

@@ -45,27 +45,22 @@ fn lstsq(cols: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
     crate::lsq::wls(cols, y, None).map(|f| (f.coef, f.resid))
 }
 
-fn sse(r: &[f64]) -> f64 {
+pub(crate) fn sse(r: &[f64]) -> f64 {
     r.iter().map(|v| v * v).sum()
+}
+
+/// The improved model's regressors at warm-up time constant `tau`:
+/// 1, dT, grad(dT), dT^2, T_K, 1 - exp(-t/tau).
+fn columns(d: &ThermalData, tau: f64) -> Vec<Vec<f64>> {
+    let (dts, grads) = dt_and_gradient(d);
+    let dt2: Vec<f64> = dts.iter().map(|v| v * v).collect();
+    let warm: Vec<f64> = d.t.iter().map(|t| 1.0 - (-t / tau).exp()).collect();
+    vec![vec![1.0; d.t.len()], dts, grads, dt2, d.case.clone(), warm]
 }
 
 /// The improved model's fit: coefficients and residual (deg/h).
 pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
-    let (dts, grads) = dt_and_gradient(d);
-    let dt2: Vec<f64> = dts.iter().map(|v| v * v).collect();
-    let ones = vec![1.0; d.t.len()];
-    let solve = |tau: f64| {
-        let warm: Vec<f64> = d.t.iter().map(|t| 1.0 - (-t / tau).exp()).collect();
-        let cols = [
-            ones.clone(),
-            dts.clone(),
-            grads.clone(),
-            dt2.clone(),
-            d.case.clone(),
-            warm,
-        ];
-        lstsq(&cols, &d.drift_dph)
-    };
+    let solve = |tau: f64| lstsq(&columns(d, tau), &d.drift_dph);
     let cost = |lt: f64| solve(lt.exp()).map_or(f64::INFINITY, |(_, r)| sse(&r));
     // Log grid 30 s .. 30 000 s, then golden section around the best.
     let (lo, hi) = (30f64.ln(), 30_000f64.ln());
@@ -99,6 +94,51 @@ pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
         },
         r,
     ))
+}
+
+/// Standard errors of the fitted coefficients (same units, same order; in
+/// `tau_warm_s` the warm-up time constant's). The least-squares covariance
+/// with the residual's variance, inflated for its correlation by batch
+/// means (the variance of 100 s means over what white noise would give);
+/// tau_warm from the curvature of the residual sum in ln(tau).
+pub fn coefficient_se(d: &ThermalData, c: &ThermalCoeffs) -> Option<ThermalCoeffs> {
+    let f = crate::lsq::wls(&columns(d, c.tau_warm_s), &d.drift_dph, None)?;
+    let n = d.t.len() as f64;
+    let var = f.sse / (n - 7.0).max(1.0);
+    let dt = (d.t[d.t.len() - 1] - d.t[0]) / (n - 1.0).max(1.0);
+    let per = (100.0 / dt).round().max(1.0);
+    let means = window_means(&d.t, &f.resid, 100.0);
+    let m = means.len() as f64;
+    let mv = means.iter().sum::<f64>() / m.max(1.0);
+    let var_means = means.iter().map(|x| (x - mv).powi(2)).sum::<f64>() / (m - 1.0).max(1.0);
+    let inflation = (var_means * per / var).max(1.0);
+    let v = var * inflation;
+    let sse_at = |lt: f64| {
+        crate::lsq::wls(&columns(d, lt.exp()), &d.drift_dph, None).map_or(f64::NAN, |f| f.sse)
+    };
+    let (l0, h) = (c.tau_warm_s.ln(), 0.05);
+    let curv = (sse_at(l0 + h) - 2.0 * f.sse + sse_at(l0 - h)) / (h * h);
+    let se_ln_tau = if curv > 0.0 {
+        (2.0 * v / curv).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Some(ThermalCoeffs {
+        bias0_dph: f.se(0, v),
+        k1_dph_per_c: f.se(1, v),
+        k2_dph_per_c_per_s: f.se(2, v),
+        k3_dph_per_c2: f.se(3, v),
+        k4_dph_per_c: f.se(4, v),
+        k5_dph: f.se(5, v),
+        tau_warm_s: c.tau_warm_s * se_ln_tau,
+    })
+}
+
+/// Standard error of a standard deviation of `m` values (normal noise):
+/// sd / sqrt(2 (m - 1)).
+pub fn std_se(sd: f64, t: &[f64], window_s: f64) -> f64 {
+    let m = window_means(t, &vec![0.0; t.len()], window_s).len() as f64;
+    sd / (2.0 * (m - 1.0)).max(1.0).sqrt()
 }
 
 /// Classic model: `B = c0 + K3*T + K2*T^2 + K1*T^3` from one sensor.

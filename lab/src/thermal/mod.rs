@@ -6,7 +6,9 @@ pub mod fit;
 use crate::error::LabError;
 use crate::table::Table;
 use clap::Args;
-use fit::{fit_thermal, noise_floor_100s, std_of_means, CubicModel, ThermalData};
+use fit::{
+    coefficient_se, fit_thermal, noise_floor_100s, std_of_means, std_se, CubicModel, ThermalData,
+};
 use gyro_coeffs::file::CoeffFile;
 use gyro_sp::rlg::thermal::{Temperatures, ThermalComp, ThermalConfig};
 use gyro_sp::rlg::{compensate_rate_ndps, ThermalCoeffs};
@@ -85,12 +87,16 @@ pub struct FitThermalArgs {
 #[derive(Debug, serde::Serialize)]
 pub struct FitSummary {
     pub coefficients: ThermalCoeffs,
+    /// Their standard errors (residual correlation included; see fit.rs).
+    pub coefficient_se: Option<ThermalCoeffs>,
     /// Standard deviation of 100 s means, deg/h: raw drift, after the
     /// improved model (float fit), after the classic one-sensor cubic.
     pub raw_std_100s_dph: f64,
     pub residual_std_100s_dph: f64,
     pub cubic_std_100s_dph: f64,
     pub noise_floor_100s_dph: f64,
+    /// Standard error of each standard deviation above (same order).
+    pub std_100s_se_dph: [f64; 4],
     pub cubic: CubicModel,
 }
 
@@ -117,12 +123,20 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
         .map(|(y, t)| y - cubic.eval(*t))
         .collect();
     let coefficients = c;
+    let stds = [
+        std_of_means(&d.t, &d.drift_dph, 100.0),
+        std_of_means(&d.t, &resid, 100.0),
+        std_of_means(&d.t, &cubic_res, 100.0),
+        noise_floor_100s(&d.t, &d.drift_dph),
+    ];
     let s = FitSummary {
         coefficients,
-        raw_std_100s_dph: std_of_means(&d.t, &d.drift_dph, 100.0),
-        residual_std_100s_dph: std_of_means(&d.t, &resid, 100.0),
-        cubic_std_100s_dph: std_of_means(&d.t, &cubic_res, 100.0),
-        noise_floor_100s_dph: noise_floor_100s(&d.t, &d.drift_dph),
+        coefficient_se: coefficient_se(&d, &c),
+        raw_std_100s_dph: stds[0],
+        residual_std_100s_dph: stds[1],
+        cubic_std_100s_dph: stds[2],
+        noise_floor_100s_dph: stds[3],
+        std_100s_se_dph: stds.map(|x| std_se(x, &d.t, 100.0)),
         cubic: cubic.clone(),
     };
     let mut info = toml::Table::new();
@@ -155,10 +169,35 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
             serde_json::to_string(&s).map_err(|e| LabError::Io(e.to_string()))?
         );
     } else {
-        println!("coefficients: {:?}", s.coefficients);
+        let v = s.coefficients.values();
+        let e = s.coefficient_se.map(|c| c.values());
+        let names = [
+            "bias0_dph",
+            "k1_dph_per_c",
+            "k2_dph_per_c_per_s",
+            "k3_dph_per_c2",
+            "k4_dph_per_c",
+            "k5_dph",
+            "tau_warm_s",
+        ];
+        for (k, n) in names.iter().enumerate() {
+            match e {
+                Some(e) => println!("  {n:<20} {:>12.6} +- {:.6}", v[k], e[k]),
+                None => println!("  {n:<20} {:>12.6} (standard error not available)", v[k]),
+            }
+        }
+        let se = s.std_100s_se_dph;
         println!(
-            "std of 100 s means: raw {:.4} deg/h, classic cubic {:.4}, improved model {:.4}, noise floor {:.4}",
-            s.raw_std_100s_dph, s.cubic_std_100s_dph, s.residual_std_100s_dph, s.noise_floor_100s_dph
+            "std of 100 s means (+- standard error): raw {:.4} +- {:.4} deg/h, classic cubic {:.4} +- {:.4}, \
+             improved model {:.4} +- {:.4}, noise floor {:.4} +- {:.4}",
+            s.raw_std_100s_dph,
+            se[0],
+            s.cubic_std_100s_dph,
+            se[2],
+            s.residual_std_100s_dph,
+            se[1],
+            s.noise_floor_100s_dph,
+            se[3]
         );
         println!("written: {}", a.out.display());
     }
@@ -186,6 +225,10 @@ pub struct CompensateSummary {
     pub raw_std_100s_dph: f64,
     pub comp_std_100s_dph: f64,
     pub noise_floor_100s_dph: f64,
+    /// Standard errors of the three figures above.
+    pub raw_std_100s_se_dph: f64,
+    pub comp_std_100s_se_dph: f64,
+    pub noise_floor_100s_se_dph: f64,
     /// comp / noise floor.
     pub comp_over_floor: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -236,10 +279,14 @@ fn compensate_rlg(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError>
         }
         None => None,
     };
+    let raw_std = std_of_means(&d.t, &d.drift_dph, 100.0);
     let s = CompensateSummary {
-        raw_std_100s_dph: std_of_means(&d.t, &d.drift_dph, 100.0),
+        raw_std_100s_dph: raw_std,
         comp_std_100s_dph: comp_std,
         noise_floor_100s_dph: floor,
+        raw_std_100s_se_dph: std_se(raw_std, &d.t, 100.0),
+        comp_std_100s_se_dph: std_se(comp_std, &d.t, 100.0),
+        noise_floor_100s_se_dph: std_se(floor, &d.t, 100.0),
         comp_over_floor: comp_std / floor,
         cubic_std_100s_dph: cubic_std,
         coeffs_refused: c.check().is_err(),
@@ -252,11 +299,14 @@ fn compensate_rlg(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError>
         );
     } else {
         println!(
-            "std of 100 s means: raw {:.4} deg/h, compensated {:.4} deg/h ({:.2}x the noise floor {:.4}){}",
+            "std of 100 s means: raw {:.4} +- {:.4} deg/h, compensated {:.4} +- {:.4} deg/h ({:.2}x the noise floor {:.4} +- {:.4}){}",
             s.raw_std_100s_dph,
+            s.raw_std_100s_se_dph,
             s.comp_std_100s_dph,
+            s.comp_std_100s_se_dph,
             s.comp_over_floor,
             s.noise_floor_100s_dph,
+            s.noise_floor_100s_se_dph,
             s.cubic_std_100s_dph
                 .map_or(String::new(), |v| format!(", classic cubic {v:.4}"))
         );
