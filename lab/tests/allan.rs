@@ -211,3 +211,34 @@ fn bad_input_is_one_line_and_exit_2() {
         assert!(err.contains(what), "{name}: {err}");
     }
 }
+
+#[test]
+fn agrees_with_allantools() {
+    // A record and allantools' overlapping deviations of it, produced
+    // offline (lab/tests/data; allantools from PyPI): ours within 1e-9.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let (code, stdout, err) = lab(&[
+        "allan",
+        "--data",
+        dir.join("white_rw.csv").to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let ours: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    let theirs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("allantools_oadev.json")).unwrap())
+            .unwrap();
+    let taus = theirs["taus_s"].as_array().unwrap();
+    assert!(taus.len() >= 25);
+    for (i, t) in taus.iter().enumerate() {
+        let k = ours["taus_s"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|x| x.as_f64() == t.as_f64())
+            .unwrap_or_else(|| panic!("tau {t} not among ours"));
+        let a = ours["adev_dph"][k].as_f64().unwrap() / 3600.0;
+        let b = theirs["oadev"][i].as_f64().unwrap();
+        assert!((a - b).abs() / b < 1e-9, "tau {t}: {a} vs allantools {b}");
+    }
+}
