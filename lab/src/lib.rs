@@ -10,6 +10,7 @@ pub mod lockin;
 pub mod lsq;
 pub mod report;
 pub mod scale_factor;
+pub mod search;
 pub mod simulate;
 pub mod stats;
 pub mod table;

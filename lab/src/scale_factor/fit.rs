@@ -22,6 +22,7 @@
 //!   cannot place it.
 
 use crate::lsq::{wls, LsFit};
+use crate::search::{golden, grid_then_golden, profile_interval, CHI2_1_95};
 use gyro_coeffs::fog_scale_factor::{ScaleFactorTable, MAX_NODES};
 use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig, LEAD_FILTER_TAU_S};
 use gyro_sp::fog::{FogConfig, FogParams};
@@ -36,8 +37,6 @@ pub const BIN_S: f64 = 10.0;
 pub const MAX_KNEES: usize = 3;
 /// Knees stay this far from the ends of the data and from each other, degC.
 const KNEE_MARGIN_C: f64 = 3.0;
-/// 95 % point of chi-square with one degree of freedom.
-const CHI2_1_95: f64 = 3.841_458_820_694_124;
 /// Window of the scale-factor residual figure, s.
 pub const RESIDUAL_WINDOW_S: f64 = 60.0;
 
@@ -382,48 +381,18 @@ impl Model {
     /// around `hint`), then golden section.
     fn best_lag(&self, knees: &[f64], hint: Option<f64>) -> (f64, f64) {
         let f = |l: f64| self.sse(l, knees);
-        let (a, b) = match hint {
-            Some(h) => ((h - 15.0).max(0.0), h + 15.0),
-            None => {
-                let grid = [
+        match hint {
+            Some(h) => golden(f, (h - 15.0).max(0.0), h + 15.0, 24),
+            None => grid_then_golden(
+                f,
+                &[
                     0.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 180.0, 240.0, 360.0,
                     480.0, 600.0,
-                ];
-                let vals: Vec<f64> = grid.iter().map(|&l| f(l)).collect();
-                let i = (0..grid.len())
-                    .min_by(|&x, &y| vals[x].total_cmp(&vals[y]))
-                    .unwrap_or(0);
-                (grid[i.saturating_sub(1)], grid[(i + 1).min(grid.len() - 1)])
-            }
-        };
-        golden(f, a, b, 24)
-    }
-}
-
-/// Minimum of `f` on [a, b] by golden section: (x, f(x)).
-fn golden(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64, iters: usize) -> (f64, f64) {
-    let g = 0.618_033_988_749_895;
-    let (mut c, mut e) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fe) = (f(c), f(e));
-    for _ in 0..iters {
-        if fc < fe {
-            b = e;
-            e = c;
-            fe = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = e;
-            fc = fe;
-            e = a + g * (b - a);
-            fe = f(e);
+                ],
+                24,
+            ),
         }
     }
-    let ends = [(a, f(a)), (b, f(b)), (c, fc), (e, fe)];
-    ends.into_iter()
-        .min_by(|x, y| x.1.total_cmp(&y.1))
-        .unwrap_or((a, f64::INFINITY))
 }
 
 /// Where knee `j` may go: inside the data margin, away from its neighbours.
@@ -476,36 +445,6 @@ fn refine(m: &Model, c: &mut Candidate, lo: f64, hi: f64) {
         c.lag = lag;
         c.sse = sse;
     }
-}
-
-/// Profile interval of a scalar: scans from `x0` in steps of `step` each
-/// way until `prof(x) - sse_min` exceeds `thr` or a bound is reached;
-/// linear interpolation at the crossing.
-fn profile_interval(
-    prof: impl Fn(f64) -> f64,
-    x0: f64,
-    sse_min: f64,
-    thr: f64,
-    step: f64,
-    (lo, hi): (f64, f64),
-) -> (f64, f64) {
-    let side = |dir: f64, bound: f64| {
-        let (mut x, mut dprev) = (x0, 0.0);
-        loop {
-            let nx = x + dir * step;
-            if (dir > 0.0 && nx > bound) || (dir < 0.0 && nx < bound) {
-                return bound;
-            }
-            let dv = prof(nx) - sse_min;
-            if dv > thr {
-                let f = ((thr - dprev) / (dv - dprev)).clamp(0.0, 1.0);
-                return x + dir * step * f;
-            }
-            x = nx;
-            dprev = dv.max(0.0);
-        }
-    };
-    (side(-1.0, lo), side(1.0, hi))
 }
 
 /// The fit of a continuous-rotation run.

@@ -65,22 +65,8 @@ pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
     // Log grid 30 s .. 30 000 s, then golden section around the best.
     let (lo, hi) = (30f64.ln(), 30_000f64.ln());
     let grid: Vec<f64> = (0..=24).map(|i| lo + (hi - lo) * i as f64 / 24.0).collect();
-    let best = grid
-        .iter()
-        .copied()
-        .min_by(|x, y| cost(*x).total_cmp(&cost(*y)))?;
-    let step = (hi - lo) / 24.0;
-    let (mut a, mut b) = ((best - step).max(lo), (best + step).min(hi));
-    let g = 0.618_033_988_75;
-    for _ in 0..40 {
-        let (c, e) = (b - g * (b - a), a + g * (b - a));
-        if cost(c) < cost(e) {
-            b = e;
-        } else {
-            a = c;
-        }
-    }
-    let tau = (0.5 * (a + b)).exp();
+    let (best, _) = crate::search::grid_then_golden(cost, &grid, 40);
+    let tau = best.exp();
     let (c, r) = solve(tau)?;
     Some((
         ThermalCoeffs {
