@@ -5,9 +5,12 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod allan;
+pub mod discover;
+pub mod effects;
 pub mod error;
 pub mod lockin;
 pub mod lsq;
+pub mod model;
 pub mod report;
 pub mod scale_factor;
 pub mod search;

@@ -75,7 +75,10 @@ pub fn wls(cols: &[Vec<f64>], y: &[f64], w: Option<&[f64]>) -> Option<LsFit> {
     if rmax.is_nan() || rmax <= 0.0 || (0..m).any(|j| r[(j, j)].abs() < rmax * 1e-10) {
         return None;
     }
-    let qty = qr.q().transpose() * &yv;
+    // Q'y without forming Q (n x m).
+    let mut qty = yv;
+    qr.q_tr_mul(&mut qty);
+    let qty = DVector::from_fn(m, |i, _| qty[i]);
     let sol = r.solve_upper_triangular(&qty)?;
     let rinv = r.solve_upper_triangular(&DMatrix::identity(m, m))?;
     let inv = &rinv * rinv.transpose();

@@ -3,7 +3,7 @@
 //! error naming the file, line and column.
 
 use gyro_lab::error::LabError;
-use gyro_lab::{allan, lockin, scale_factor, simulate, thermal};
+use gyro_lab::{allan, discover, lockin, scale_factor, simulate, thermal};
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -32,6 +32,8 @@ enum Cmd {
     Fit(FitCmd),
     /// Noise analysis: overlapping Allan deviation, IEEE 952 terms with intervals.
     Allan(allan::AllanArgs),
+    /// Compare a model with measured data: name the missing effect, add it, show the gap shrink.
+    Discover(discover::DiscoverArgs),
     /// Apply a coefficient file as the firmware does; adds `rate_comp_dps`.
     Compensate(thermal::CompensateArgs),
     /// Benchmarks of the estimators on simulated records.
@@ -57,6 +59,8 @@ enum BenchCmd {
     Allan(allan::bench::AllanBenchArgs),
     /// Allan analysis time on 10^7 samples against the O(N m) definition.
     AllanSpeed(allan::bench::SpeedArgs),
+    /// Discovery on randomized runs with hidden effects: the confusion table.
+    Discover(discover::bench::DiscoverBenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -83,10 +87,12 @@ fn main() -> ExitCode {
         Cmd::Fit(FitCmd::ScaleFactor(a)) => scale_factor::fit_run(&a),
         Cmd::Compensate(a) => thermal::compensate_run(&a),
         Cmd::Allan(a) => allan::run(&a),
+        Cmd::Discover(a) => discover::run(&a),
         Cmd::Bench(BenchCmd::Lockin(a)) => lockin::bench_run(&a),
         Cmd::Bench(BenchCmd::ScaleFactor(a)) => scale_factor::bench::run(&a),
         Cmd::Bench(BenchCmd::Allan(a)) => allan::bench::run(&a),
         Cmd::Bench(BenchCmd::AllanSpeed(a)) => allan::bench::speed(&a),
+        Cmd::Bench(BenchCmd::Discover(a)) => discover::bench::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

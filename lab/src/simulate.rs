@@ -21,6 +21,8 @@ pub enum SimulateCmd {
     Chamber(crate::thermal::chamber::ChamberArgs),
     /// FOG scale-factor calibration run over temperature (continuous rotation or multi-point; writes a run file).
     ScaleFactor(crate::scale_factor::SimulateArgs),
+    /// A gyro model (model.toml) on a test profile with the project's noise: a run with known effects.
+    Run(crate::discover::trials::SimulateRunArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -40,6 +42,11 @@ pub struct FogArgs {
     /// Frequency of the oscillation, Hz.
     #[arg(long, requires = "vibration_dps2")]
     pub vibration_hz: Option<f64>,
+    /// Vibration levels as fractions of the peak, played one after another
+    /// for equal parts of the run (e.g. 0,0.5,1: at rest, half, full); at
+    /// most 8. Default: the full level throughout.
+    #[arg(long, value_delimiter = ',', requires = "vibration_dps2")]
+    pub vibration_levels: Vec<f64>,
     /// Simulated time, s.
     #[arg(long, default_value_t = 1.0)]
     pub duration_s: f64,
@@ -103,6 +110,7 @@ pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
         SimulateCmd::Lockin(a) => crate::lockin::simulate(&a),
         SimulateCmd::Chamber(a) => crate::thermal::chamber::simulate(&a),
         SimulateCmd::ScaleFactor(a) => crate::scale_factor::simulate(&a),
+        SimulateCmd::Run(a) => crate::discover::trials::simulate(&a),
         SimulateCmd::Fog(a) => {
             let s = simulate_fog(&a)?;
             if a.json {
@@ -192,21 +200,51 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
 
     let rate = a.rate_dps * DEG;
     let mut period = None;
+    let levels: Vec<f64> = if a.vibration_levels.is_empty() {
+        vec![1.0]
+    } else {
+        a.vibration_levels.clone()
+    };
+    if levels.len() > 8 {
+        return Err(LabError::Usage("--vibration-levels: at most 8".into()));
+    }
+    for &l in &levels {
+        check("vibration-levels", l, (0.0..=1.0).contains(&l))?;
+    }
     let profile = match (a.vibration_dps2, a.vibration_hz) {
         (Some(eps), Some(f)) => {
             check("vibration-dps2", eps, eps >= 0.0)?;
             check("vibration-hz", f, f > 0.0 && f < a.closure_hz / 4.0)?;
             period = Some(1.0 / f);
-            Profile::new(&[Segment::Oscillation {
-                offset: rate,
-                eps_peak: eps * DEG,
-                freq_hz: f,
-                duration: f64::INFINITY,
-            }])
+            // Equal parts of whole periods (the rate continuous at each
+            // change: every segment starts at a zero crossing).
+            let part = if levels.len() > 1 {
+                (a.duration_s / levels.len() as f64 * f).floor().max(1.0) / f
+            } else {
+                f64::INFINITY
+            };
+            let segs: Vec<Segment<f64>> = levels
+                .iter()
+                .enumerate()
+                .map(|(i, &l)| Segment::Oscillation {
+                    offset: rate,
+                    eps_peak: eps * DEG * l,
+                    freq_hz: f,
+                    duration: if i + 1 == levels.len() {
+                        f64::INFINITY
+                    } else {
+                        part
+                    },
+                })
+                .collect();
+            Profile::new(&segs)
         }
         _ => Profile::constant(rate),
     };
-    let mean_eps_sq = a.vibration_dps2.map_or(0.0, |e| (e * DEG).powi(2) / 2.0);
+    let mean_level_sq = levels.iter().map(|l| l * l).sum::<f64>() / levels.len() as f64;
+    let mean_eps_sq = a
+        .vibration_dps2
+        .map_or(0.0, |e| (e * DEG).powi(2) / 2.0 * mean_level_sq);
     let predicted = cfg.predicted_vibration_drift(mean_eps_sq) * DPH_PER_RAD_S;
 
     let dt = cfg.closure_period_s();
@@ -257,7 +295,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
             writeln!(w, "# gyro-lab simulate fog: means over 25 closure steps")?;
             writeln!(
                 w,
-                "t_s,ref_rate_dps,rate_dps,rate_raw_dps,residual_rad,codes_per_turn,faults"
+                "t_s,ref_rate_dps,rate_dps,rate_raw_dps,ref_acc_dps2,residual_rad,codes_per_turn,faults"
             )?;
             Some(w)
         }
@@ -294,13 +332,17 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
             acc_n += 1;
             if acc_n == 25 {
                 let n = acc_n as f64;
+                // Acceleration at the row's middle: its square samples the
+                // oscillation's phases evenly (the rectification's mean).
+                let t_mid = r.t_end - 12.5 * dt;
                 writeln!(
                     w,
-                    "{:.6},{:.9},{:.9},{:.9},{:.6e},{:.3},{}",
-                    r.t_end - 12.0 * dt,
+                    "{:.6},{:.9},{:.9},{:.9},{:.6},{:.6e},{:.3},{}",
+                    t_mid,
                     acc[0] / n / DEG,
                     acc[1] / n / DEG,
                     acc[2] / n / DEG,
+                    rig.profile.accel_at(t_mid) / DEG,
                     acc[3] / n,
                     r.out.codes_per_turn_q8 as f64 / 256.0,
                     r.out.faults.0

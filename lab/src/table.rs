@@ -206,6 +206,17 @@ pub struct Columns {
 
 impl Columns {
     pub fn read(path: &Path, cols: &[&str]) -> Result<Self, LabError> {
+        Self::read_with(path, cols, &[]).map(|(c, _)| c)
+    }
+
+    /// `required` columns, and of `optional` those the file has: returns
+    /// the columns (required first, then the optional ones present) and,
+    /// per optional column, its index in `data` if present.
+    pub fn read_with(
+        path: &Path,
+        required: &[&str],
+        optional: &[&str],
+    ) -> Result<(Self, Vec<Option<usize>>), LabError> {
         let name = path.display().to_string();
         let file = std::fs::File::open(path)
             .map_err(|e| LabError::Input(format!("{name}: cannot read: {e}")))?;
@@ -230,11 +241,23 @@ impl Columns {
             .map(|f| String::from_utf8_lossy(f).into_owned())
             .collect();
         let mut fields = Vec::new();
-        for c in cols {
+        let mut cols: Vec<&str> = required.to_vec();
+        for c in required {
             let i = header.iter().position(|h| h == c).ok_or_else(|| {
                 LabError::Input(format!("{name}:{header_line}: missing column `{c}`"))
             })?;
             fields.push(i + 1);
+        }
+        let mut present = vec![];
+        for c in optional {
+            match header.iter().position(|h| h == c) {
+                Some(i) => {
+                    present.push(Some(cols.len()));
+                    cols.push(c);
+                    fields.push(i + 1);
+                }
+                None => present.push(None),
+            }
         }
         let mut data: Vec<Vec<f64>> = cols.iter().map(|_| Vec::new()).collect();
         let mut lines = Vec::new();
@@ -259,13 +282,16 @@ impl Columns {
             }
             lines.push(line);
         }
-        Ok(Self {
-            path: path.to_owned(),
-            header_line,
-            data,
-            lines,
-            fields,
-        })
+        Ok((
+            Self {
+                path: path.to_owned(),
+                header_line,
+                data,
+                lines,
+                fields,
+            },
+            present,
+        ))
     }
 
     pub fn len(&self) -> usize {

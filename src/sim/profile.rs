@@ -44,6 +44,20 @@ impl<F: Float> Segment<F> {
             }
         }
     }
+
+    /// Angular acceleration (rad/s^2) at local time `t`.
+    pub fn accel_at(&self, t: F) -> F {
+        match *self {
+            Segment::Constant { .. } => F::zero(),
+            Segment::Ramp { from, to, duration } => (to - from) / duration,
+            Segment::Oscillation {
+                eps_peak, freq_hz, ..
+            } => {
+                let w = F::from(core::f64::consts::TAU).unwrap_or(F::zero()) * freq_hz;
+                eps_peak * (w * t).cos()
+            }
+        }
+    }
 }
 
 /// Up to eight segments played in order; the last one holds after its end.
@@ -74,22 +88,29 @@ impl<F: Float> Profile<F> {
             .fold(F::zero(), |a, s| a + s.duration())
     }
 
-    /// Rate (rad/s) at time `t` (s) since the start.
-    pub fn rate_at(&self, t: F) -> F {
+    /// The segment playing at `t` and the local time in it.
+    fn at(&self, t: F) -> Option<(&Segment<F>, F)> {
         let mut start = F::zero();
         let mut last = None;
         for s in &self.segments {
             let end = start + s.duration();
             if t < end {
-                return s.rate_at(t - start);
+                return Some((s, t - start));
             }
             last = Some((s, start));
             start = end;
         }
-        match last {
-            Some((s, start)) => s.rate_at((t - start).min(s.duration())),
-            None => F::zero(),
-        }
+        last.map(|(s, start)| (s, (t - start).min(s.duration())))
+    }
+
+    /// Rate (rad/s) at time `t` (s) since the start.
+    pub fn rate_at(&self, t: F) -> F {
+        self.at(t).map_or(F::zero(), |(s, u)| s.rate_at(u))
+    }
+
+    /// Angular acceleration (rad/s^2) at time `t` (s) since the start.
+    pub fn accel_at(&self, t: F) -> F {
+        self.at(t).map_or(F::zero(), |(s, u)| s.accel_at(u))
     }
 }
 

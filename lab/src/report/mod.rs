@@ -115,6 +115,9 @@ pub fn sig(x: f64) -> String {
     if !x.is_finite() || x == 0.0 {
         return format!("{x}");
     }
+    if !(1e-4..1e7).contains(&x.abs()) {
+        return format!("{x:.5e}");
+    }
     let e = x.abs().log10().floor() as i32;
     let d = (5 - e).max(0) as usize;
     let s = format!("{x:.d$}");

@@ -21,16 +21,16 @@ pub struct ThermalData {
     pub drift_dph: Vec<f64>,
 }
 
-/// dT and its filtered gradient, as the firmware forms them.
-pub fn dt_and_gradient(d: &ThermalData) -> (Vec<f64>, Vec<f64>) {
-    let n = d.t.len();
+/// dT = a - b and its filtered gradient, as the firmware forms them.
+pub fn dt_and_gradient(t: &[f64], a: &[f64], b: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len();
     let mut dts: Vec<f64> = Vec::with_capacity(n);
     let mut grads = Vec::with_capacity(n);
     let mut grad = 0.0;
     for k in 0..n {
-        let dtk = (d.a[k] - d.b[k]).clamp(-32.0, 32.0);
+        let dtk = (a[k] - b[k]).clamp(-32.0, 32.0);
         if k > 0 {
-            let h = d.t[k] - d.t[k - 1];
+            let h = t[k] - t[k - 1];
             let slope = ((dtk - dts[k - 1]) / h).clamp(-8.0, 8.0);
             grad += h / (GRAD_TAU_S + h) * (slope - grad);
         }
@@ -52,7 +52,7 @@ pub(crate) fn sse(r: &[f64]) -> f64 {
 /// The improved model's regressors at warm-up time constant `tau`:
 /// 1, dT, grad(dT), dT^2, T_K, 1 - exp(-t/tau).
 fn columns(d: &ThermalData, tau: f64) -> Vec<Vec<f64>> {
-    let (dts, grads) = dt_and_gradient(d);
+    let (dts, grads) = dt_and_gradient(&d.t, &d.a, &d.b);
     let dt2: Vec<f64> = dts.iter().map(|v| v * v).collect();
     let warm: Vec<f64> = d.t.iter().map(|t| 1.0 - (-t / tau).exp()).collect();
     vec![vec![1.0; d.t.len()], dts, grads, dt2, d.case.clone(), warm]

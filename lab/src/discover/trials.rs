@@ -1,0 +1,339 @@
+//! Runs with known effects for discovery: a truth model (model.rs, the
+//! effects of effects.rs) evaluated on a test profile, plus the project's
+//! noise generator (gyro_sp::sim::noise) and its thermal simulators
+//! (gyro_sp::sim::fog_thermal's coil, gyro_sp::sim::rlg_rig's chamber).
+//! `gyro-lab simulate run` writes them; the discovery bench and tests draw
+//! them.
+
+use crate::effects::{GyroKind, Inputs};
+use crate::error::LabError;
+use crate::model::Model;
+use gyro_sp::sim::{Chamber, ChamberParams, CoilThermal, NoiseParams, RateNoise};
+use rand_core::{RngCore, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Test profiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TestProfile {
+    /// Rate table: 0, +-10, +-50, +-100, +-200 deg/s in a shuffled order,
+    /// 60 s each, while the chamber sweeps -20 -> +60 -> -20 degC (the coil
+    /// 600 s behind the air); 1 s rows, 2 h.
+    Table,
+    /// The same table at one constant rate (+50 deg/s) and constant
+    /// temperature: a scale-factor error and a bias look alike there.
+    ConstantRate,
+    /// RLG at rest in a thermal chamber (gyro_sp's chamber: case and two
+    /// monoblock sensors with their lags and self-heating), the cycle
+    /// -40 -> +50 degC; 1 s rows, 6 h.
+    Chamber,
+    /// RLG rate steps near lock-in: +-0.03 .. +-3 deg/s log-spaced, 20 s
+    /// each; 10 Hz rows, 30 min.
+    Lockin,
+    /// FOG at rest under 20 Hz sinusoidal vibration switched between
+    /// amplitudes (0, 2 000, 5 000, 10 000 deg/s^2 peak), 30 s each, with
+    /// `ref_acc_dps2`; 200 Hz rows, 10 min.
+    Vibration,
+    /// FOG under one constant vibration level: rectification looks like a
+    /// bias.
+    ConstantVibration,
+}
+
+impl TestProfile {
+    pub fn gyro(self) -> GyroKind {
+        match self {
+            TestProfile::Chamber | TestProfile::Lockin => GyroKind::Rlg,
+            _ => GyroKind::Fog,
+        }
+    }
+
+    /// Default row period and duration, s.
+    pub fn default_timing(self) -> (f64, f64) {
+        match self {
+            TestProfile::Table | TestProfile::ConstantRate => (1.0, 7200.0),
+            TestProfile::Chamber => (1.0, 6.0 * 3600.0),
+            TestProfile::Lockin => (0.1, 1800.0),
+            TestProfile::Vibration | TestProfile::ConstantVibration => (0.005, 600.0),
+        }
+    }
+}
+
+/// Noise of the simulated gyro: white rate (deg/sqrt(h)) and bias
+/// instability (deg/h).
+#[derive(Clone, Copy, Debug)]
+pub struct TrialNoise {
+    pub arw_dpsh: f64,
+    pub bias_instability_dph: f64,
+}
+
+impl TrialNoise {
+    /// A navigation-grade gyro of each kind.
+    pub fn nominal(g: GyroKind) -> Self {
+        match g {
+            GyroKind::Fog => Self {
+                arw_dpsh: 0.005,
+                bias_instability_dph: 0.005,
+            },
+            GyroKind::Rlg => Self {
+                arw_dpsh: 0.003,
+                bias_instability_dph: 0.003,
+            },
+        }
+    }
+}
+
+/// A generated run: its inputs, the measured rate, and the columns to write.
+pub struct TrialRun {
+    pub inputs: Inputs,
+    pub rate: Vec<f64>,
+    /// The mono/case columns when the profile has them (for the file).
+    pub mono: Option<(Vec<f64>, Vec<f64>)>,
+    pub case: Option<Vec<f64>>,
+    pub acc_column: bool,
+}
+
+fn triangle(t: f64, period: f64, lo: f64, hi: f64) -> f64 {
+    let p = (t / period).fract();
+    let x = if p < 0.5 { 2.0 * p } else { 2.0 - 2.0 * p };
+    lo + (hi - lo) * x
+}
+
+/// Generates a run of `profile` for the truth `model`.
+pub fn generate(
+    model: &Model,
+    profile: TestProfile,
+    noise: TrialNoise,
+    seed: u64,
+    timing: Option<(f64, f64)>,
+) -> TrialRun {
+    let (dt, dur) = timing.unwrap_or(profile.default_timing());
+    let n = (dur / dt).round() as usize;
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0xD15C_0FE2);
+    let t: Vec<f64> = (0..n).map(|k| (k + 1) as f64 * dt).collect();
+    let mut temp = None;
+    let mut mono = None;
+    let mut case = None;
+    let mut acc = None;
+    let w: Vec<f64> = match profile {
+        TestProfile::Table => {
+            let mut rates = vec![0.0, 10.0, -10.0, 50.0, -50.0, 100.0, -100.0, 200.0, -200.0];
+            // Shuffle (Fisher-Yates) so each seed orders the rates its own way.
+            for i in (1..rates.len()).rev() {
+                let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+                rates.swap(i, j);
+            }
+            let mut coil = CoilThermal::new(-20.0);
+            let mut tc = Vec::with_capacity(n);
+            for &tk in &t {
+                let air = triangle(tk, dur, -20.0, 60.0);
+                let (c, _) = coil.step(dt, air);
+                let z: f64 = StandardNormal.sample(&mut rng);
+                tc.push(((c + 0.005 * z) * 128.0).round() / 128.0);
+            }
+            temp = Some(tc);
+            t.iter()
+                .map(|&tk| rates[((tk - dt / 2.0) / 60.0) as usize % rates.len()])
+                .collect()
+        }
+        TestProfile::ConstantRate => {
+            temp = Some(vec![25.0; n]);
+            vec![50.0; n]
+        }
+        TestProfile::Chamber => {
+            let p = ChamberParams {
+                seed,
+                ..ChamberParams::default()
+            };
+            let mut ch = Chamber::new(p, 20.0);
+            let (mut a, mut b, mut k) = (vec![], vec![], vec![]);
+            for &tk in &t {
+                let air = crate::thermal::chamber::air_temperature(
+                    crate::thermal::chamber::ChamberProfile::Cycle,
+                    20.0,
+                    tk - dt / 2.0,
+                );
+                let s = ch.step(dt, air, 0.0);
+                a.push(s.t_mono_a_c);
+                b.push(s.t_mono_b_c);
+                k.push(s.t_case_c);
+            }
+            mono = Some((a, b));
+            case = Some(k);
+            // At rest, the Earth's component along an upright axis at 48 deg.
+            vec![crate::thermal::chamber::earth_component_dps(0.0, 90.0, 48.0); n]
+        }
+        TestProfile::Lockin => {
+            let mags: Vec<f64> = (0..12)
+                .map(|i| 0.03 * 10f64.powf(2.0 * i as f64 / 11.0))
+                .collect();
+            t.iter()
+                .map(|&tk| {
+                    let step = ((tk - dt / 2.0) / 20.0) as usize;
+                    let m = mags[(step / 2) % mags.len()];
+                    if step % 2 == 0 {
+                        m
+                    } else {
+                        -m
+                    }
+                })
+                .collect()
+        }
+        TestProfile::Vibration | TestProfile::ConstantVibration => {
+            let f = 20.0;
+            let wv = std::f64::consts::TAU * f;
+            let levels = [0.0, 2_000.0, 5_000.0, 10_000.0];
+            let eps = |tk: f64| {
+                if profile == TestProfile::ConstantVibration {
+                    5_000.0
+                } else {
+                    levels[((tk / 30.0) as usize) % levels.len()]
+                }
+            };
+            // Rate and acceleration at the row's middle (the rates are the
+            // oscillation's values there; the rectification responds to
+            // eps^2, whose row mean this samples without bias).
+            let mid: Vec<f64> = t.iter().map(|tk| tk - dt / 2.0).collect();
+            acc = Some(mid.iter().map(|&tm| eps(tm) * (wv * tm).cos()).collect());
+            mid.iter()
+                .map(|&tm| eps(tm) / wv * (wv * tm).sin())
+                .collect()
+        }
+    };
+    let acc_column = acc.is_some();
+    let inputs = Inputs::new(t, w, temp, mono.clone(), case.clone(), acc);
+    let mut g = RateNoise::new(
+        NoiseParams {
+            n_dps_rts: NoiseParams::arw_from_dpsh(noise.arw_dpsh),
+            b_dps: NoiseParams::b_from_dph(noise.bias_instability_dph),
+            // Bias instability up to a third of the record (as far as the
+            // run's Allan deviation reaches): slower processes would only
+            // add a turn-on bias, which no record can tell from a bias
+            // effect.
+            flicker_max_tau_s: dur / 3.0,
+            ..NoiseParams::default()
+        },
+        dt,
+        seed,
+    );
+    let rate: Vec<f64> = model
+        .evaluate(&inputs)
+        .iter()
+        .map(|y| y + g.sample())
+        .collect();
+    TrialRun {
+        inputs,
+        rate,
+        mono,
+        case,
+        acc_column,
+    }
+}
+
+/// Writes a run file.
+pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for l in comment.lines() {
+        writeln!(f, "# {l}")?;
+    }
+    let inp = &run.inputs;
+    let mut head = vec!["t_s", "ref_rate_dps", "rate_dps"];
+    if inp.temp.is_some() {
+        head.push("temp_c");
+    }
+    if run.mono.is_some() {
+        head.extend(["t_mono_a_c", "t_mono_b_c"]);
+    }
+    if run.case.is_some() {
+        head.push("t_case_c");
+    }
+    if run.acc_column {
+        head.push("ref_acc_dps2");
+    }
+    writeln!(f, "{}", head.join(","))?;
+    for k in 0..inp.len() {
+        write!(f, "{},{:.9},{:.12e}", inp.t[k], inp.w[k], run.rate[k])?;
+        if let Some(tc) = &inp.temp {
+            write!(f, ",{:.4}", tc[k])?;
+        }
+        if let Some((a, b)) = &run.mono {
+            write!(f, ",{:.4},{:.4}", a[k], b[k])?;
+        }
+        if let Some(c) = &run.case {
+            write!(f, ",{:.4}", c[k])?;
+        }
+        if run.acc_column {
+            write!(f, ",{:.6}", inp.acc[k])?;
+        }
+        writeln!(f)?;
+    }
+    f.flush()
+}
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct SimulateRunArgs {
+    /// The truth: a model file (its gyro kind must match the profile's).
+    #[arg(long)]
+    pub model: PathBuf,
+    #[arg(long, value_enum)]
+    pub profile: TestProfile,
+    /// Row period and duration, s (default: the profile's).
+    #[arg(long)]
+    pub dt_s: Option<f64>,
+    #[arg(long)]
+    pub duration_s: Option<f64>,
+    /// Angle random walk, deg/sqrt(h), and bias instability, deg/h
+    /// (default: a navigation-grade gyro of the profile's kind).
+    #[arg(long)]
+    pub arw_dpsh: Option<f64>,
+    #[arg(long)]
+    pub bias_instability_dph: Option<f64>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn simulate(a: &SimulateRunArgs) -> Result<(), LabError> {
+    let model = Model::read(&a.model, a.profile.gyro()).map_err(LabError::Input)?;
+    let (dt0, dur0) = a.profile.default_timing();
+    let dt = a.dt_s.unwrap_or(dt0);
+    let dur = a.duration_s.unwrap_or(dur0);
+    if !(dt.is_finite() && dt > 0.0 && dur.is_finite() && dur >= 10.0 * dt && dur / dt <= 2e7) {
+        return Err(LabError::Usage(format!(
+            "--dt-s {dt} --duration-s {dur}: out of range"
+        )));
+    }
+    let nom = TrialNoise::nominal(a.profile.gyro());
+    let noise = TrialNoise {
+        arw_dpsh: a.arw_dpsh.unwrap_or(nom.arw_dpsh).max(0.0),
+        bias_instability_dph: a
+            .bias_instability_dph
+            .unwrap_or(nom.bias_instability_dph)
+            .max(0.0),
+    };
+    let run = generate(&model, a.profile, noise, a.seed, Some((dt, dur)));
+    write(
+        &run,
+        &a.out,
+        &format!(
+            "gyro-lab simulate run: profile {:?}, model {}, seed {}, ARW {} deg/sqrt(h), bias instability {} deg/h",
+            a.profile,
+            a.model.display(),
+            a.seed,
+            noise.arw_dpsh,
+            noise.bias_instability_dph
+        ),
+    )
+    .map_err(|e| LabError::Io(format!("{}: {e}", a.out.display())))?;
+    let j = serde_json::json!({"rows": run.inputs.len(), "out": a.out});
+    if a.json {
+        println!("{j}");
+    } else {
+        println!("{} rows -> {}", run.inputs.len(), a.out.display());
+    }
+    Ok(())
+}
