@@ -206,7 +206,7 @@ impl Design<'_> {
             x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1).max(1) as f64
         };
         let v1 = var(&r);
-        if !(v1 > 0.0) {
+        if v1.is_nan() || v1 <= 0.0 {
             return 1.0;
         }
         let mut phi: f64 = 1.0;

@@ -172,7 +172,7 @@ pub fn generate(
                 .map(|&tk| {
                     let step = ((tk - dt / 2.0) / 20.0) as usize;
                     let m = mags[(step / 2) % mags.len()];
-                    if step % 2 == 0 {
+                    if step.is_multiple_of(2) {
                         m
                     } else {
                         -m

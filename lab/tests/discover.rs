@@ -1,0 +1,377 @@
+//! `gyro-lab discover`: end to end from the sample-level simulators, one
+//! randomized trial of every effect (the 264-trial figures are `cargo lab
+//! bench discover`'s), the files and JSON it promises, and bad input.
+
+use gyro_lab::discover::bench::{draw, trial};
+use gyro_lab::discover::trials::TestProfile;
+use gyro_lab::effects::{Effect, GyroKind};
+use gyro_lab::model::Model;
+use rand_core::SeedableRng;
+use std::process::Command;
+
+fn lab(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
+        .args(args)
+        .output()
+        .expect("run gyro-lab");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("gyro-lab-discover-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn json(stdout: &str) -> serde_json::Value {
+    serde_json::from_str(stdout.lines().last().unwrap()).unwrap()
+}
+
+#[test]
+fn vibration_rectification_from_the_closed_loop_simulation() {
+    // The firmware's FOG core closed around the simulated interferometer,
+    // its epsilon-squared correction off, under 60 Hz vibration at four
+    // levels; discovered against the ideal gyro.
+    let d = dir("vib");
+    let run = d.join("vib.csv");
+    let p = |x: &std::path::Path| x.display().to_string();
+    let (code, _, err) = lab(&[
+        "simulate",
+        "fog",
+        "--no-vibration-correction",
+        "--vibration-dps2",
+        "20000",
+        "--vibration-hz",
+        "60",
+        "--vibration-levels",
+        "0,0.5,0.75,1",
+        "--duration-s",
+        "40",
+        "--out",
+        &p(&run),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = lab(&[
+        "discover",
+        "--gyro",
+        "fog",
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&d.join("o")),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = json(&out);
+    let found = v["found"].as_array().unwrap();
+    assert_eq!(found.len(), 1, "{v}");
+    assert_eq!(found[0]["effect"], "vibration_rectification");
+    // The drift the loop's own formula predicts, deg/h per (deg/s^2)^2.
+    let cfg = gyro_sp::fog::FogConfig::new(gyro_sp::fog::FogParams::default()).unwrap();
+    let deg = std::f64::consts::PI / 180.0;
+    let predicted = cfg.predicted_vibration_drift(1.0) * deg * 3600.0;
+    let k = found[0]["parameters"]["dph_per_dps2_sq"].as_f64().unwrap();
+    assert!(
+        (k / predicted - 1.0).abs() < 0.05,
+        "{k} vs predicted {predicted}"
+    );
+    assert!(
+        v["gap_after_dph"].as_f64().unwrap() < 0.2 * v["gap_before_dph"].as_f64().unwrap(),
+        "{v}"
+    );
+}
+
+#[test]
+fn warm_up_from_the_chamber_simulation() {
+    // The RLG chamber run (its truth: gyro_sp's ChamberParams::default())
+    // against a model holding every term but the warm-up.
+    let d = dir("chamber");
+    let run = d.join("ch.csv");
+    let p = |x: &std::path::Path| x.display().to_string();
+    let (code, _, err) = lab(&[
+        "simulate",
+        "chamber",
+        "--profile",
+        "cycle",
+        "--out",
+        &p(&run),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let t = gyro_sp::sim::ChamberParams::default().truth;
+    let model = d.join("model.toml");
+    std::fs::write(
+        &model,
+        format!(
+            "kind = \"gyro_model\"\nversion = 1\ngyro = \"rlg\"\n\
+             [[effect]]\nname = \"bias\"\nbias_dph = {}\n\
+             [[effect]]\nname = \"thermal_difference\"\ndph_per_c = {}\n\
+             [[effect]]\nname = \"thermal_gradient\"\ndph_per_c_per_s = {}\n\
+             [[effect]]\nname = \"thermal_difference_squared\"\ndph_per_c2 = {}\n\
+             [[effect]]\nname = \"case_temperature\"\ndph_per_c = {}\n",
+            // case_temperature is k4 (T_K - 20): the constant moves to the bias.
+            t.bias0_dph + 20.0 * t.k4_dph_per_c,
+            t.k1_dph_per_c,
+            t.k2_dph_per_c_per_s,
+            t.k3_dph_per_c2,
+            t.k4_dph_per_c
+        ),
+    )
+    .unwrap();
+    let (code, out, err) = lab(&[
+        "discover",
+        "--gyro",
+        "rlg",
+        "--model",
+        &p(&model),
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&d.join("o")),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = json(&out);
+    let found = v["found"].as_array().unwrap();
+    assert_eq!(found.len(), 1, "{v}");
+    assert_eq!(found[0]["effect"], "warm_up");
+    let a = found[0]["parameters"]["amplitude_dph"].as_f64().unwrap();
+    assert!((a / t.k5_dph - 1.0).abs() < 0.1, "{a}");
+    let iv = &found[0]["parameter_intervals"]["tau_s"];
+    assert!(
+        iv[0].as_f64().unwrap() <= t.tau_warm_s && t.tau_warm_s <= iv[1].as_f64().unwrap(),
+        "{iv}"
+    );
+}
+
+#[test]
+fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(99);
+    let model_of = |g: GyroKind, e| Model {
+        gyro: g,
+        nominal: toml::Table::new(),
+        effects: e,
+    };
+    for (i, e) in Effect::ALL.into_iter().enumerate() {
+        let (p, h, known) = draw(e, &mut rng);
+        let mut truth = known.clone();
+        truth.push(h.clone());
+        let o = trial(
+            e.name(),
+            p,
+            &model_of(p.gyro(), truth),
+            &model_of(p.gyro(), known),
+            &[h],
+            500 + i as u64,
+        );
+        assert!(o.named_right && o.params_ok && o.gap_ok, "{o:?}");
+    }
+    // Nothing missing: the model is the truth.
+    let (p, h, mut known) = draw(Effect::ThermalDifference, &mut rng);
+    known.push(h);
+    let m = model_of(p.gyro(), known);
+    let o = trial("nothing", p, &m, &m, &[], 601);
+    assert!(o.named.is_empty() && o.ambiguous.is_empty(), "{o:?}");
+    // Two hidden.
+    let hidden = vec![
+        draw(Effect::Bias, &mut rng).1,
+        draw(Effect::ScaleFactorError, &mut rng).1,
+    ];
+    let o = trial(
+        "two",
+        TestProfile::Table,
+        &model_of(GyroKind::Fog, hidden.clone()),
+        &model_of(GyroKind::Fog, vec![]),
+        &hidden,
+        602,
+    );
+    assert!(o.named_right && o.params_ok, "{o:?}");
+    // Collinear by construction: a scale-factor error at one rate is a bias.
+    let h = draw(Effect::ScaleFactorError, &mut rng).1;
+    let o = trial(
+        "collinear",
+        TestProfile::ConstantRate,
+        &model_of(GyroKind::Fog, vec![h.clone()]),
+        &model_of(GyroKind::Fog, vec![]),
+        &[h],
+        603,
+    );
+    assert!(o.named.is_empty(), "{o:?}");
+    let g = &o.ambiguous[0];
+    assert!(
+        g.contains(&"bias") && g.contains(&"scale_factor_error"),
+        "{o:?}"
+    );
+}
+
+#[test]
+fn outputs_and_the_model_written_back() {
+    let d = dir("files");
+    let p = |x: &std::path::Path| x.display().to_string();
+    let truth = d.join("truth.toml");
+    std::fs::write(
+        &truth,
+        "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n[[effect]]\nname = \"scale_factor_temperature\"\nppm_per_c = 2.5\n",
+    )
+    .unwrap();
+    let run = d.join("run.csv");
+    let (code, _, err) = lab(&[
+        "simulate",
+        "run",
+        "--model",
+        &p(&truth),
+        "--profile",
+        "table",
+        "--duration-s",
+        "3600",
+        "--out",
+        &p(&run),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let out = d.join("o");
+    let (code, stdout, err) = lab(&[
+        "discover",
+        "--gyro",
+        "fog",
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&out),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = json(&stdout);
+    for k in [
+        "found",
+        "gap_before_dph",
+        "gap_after_dph",
+        "noise_floor_dph",
+        "ambiguous",
+    ] {
+        assert!(v.get(k).is_some(), "{k}: {v}");
+    }
+    let f = &v["found"][0];
+    assert_eq!(f["effect"], "scale_factor_temperature");
+    for k in [
+        "parameters",
+        "delta_bic",
+        "explained_share",
+        "parameter_intervals",
+    ] {
+        assert!(f.get(k).is_some(), "{k}: {f}");
+    }
+    let csv = std::fs::read_to_string(out.join("residual.csv")).unwrap();
+    assert!(csv.starts_with("t_s,residual_before_dps,residual_after_dps\n"));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let stripped = html.replace("xmlns=\"http://www.w3.org/2000/svg\"", "");
+    for bad in [
+        "<script", "<link", "src=", "href=", "url(", "http:", "https:",
+    ] {
+        assert!(!stripped.contains(bad), "report holds `{bad}`");
+    }
+    // Residual over time, Allan before/after, the effect against its regressor.
+    assert!(html.matches("<svg").count() >= 3);
+    assert!(html.contains("time since power-on, s") && html.contains("averaging time tau, s"));
+    assert!(html.contains("scale_factor_temperature contribution, deg/h"));
+    // The model written back explains the run: nothing more is missing.
+    let (code, stdout, err) = lab(&[
+        "discover",
+        "--gyro",
+        "fog",
+        "--model",
+        &p(&out.join("model.toml")),
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&d.join("o2")),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v2 = json(&stdout);
+    assert!(v2["found"].as_array().unwrap().is_empty(), "{v2}");
+    assert!(
+        (v2["gap_before_dph"].as_f64().unwrap() - v["gap_after_dph"].as_f64().unwrap()).abs()
+            < 1e-6
+    );
+}
+
+#[test]
+fn bad_input_is_one_line_and_exit_2() {
+    let d = dir("bad");
+    let p = |x: &std::path::Path| x.display().to_string();
+    let run = d.join("run.csv");
+    let rows: String = (0..100).map(|k| format!("{k},10,10.001\n")).collect();
+    std::fs::write(&run, format!("t_s,ref_rate_dps,rate_dps\n{rows}")).unwrap();
+    let write = |name: &str, text: &str| {
+        let f = d.join(name);
+        std::fs::write(&f, text).unwrap();
+        p(&f)
+    };
+    let cases = [
+        (
+            write("rlg.toml", "kind = \"gyro_model\"\nversion = 1\ngyro = \"rlg\"\n"),
+            ":3:8",
+            "a model of the rlg but --gyro fog",
+        ),
+        (
+            write("unknown.toml", "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n[[effect]]\nname = \"coriolis\"\n"),
+            ":5:8",
+            "unknown effect `coriolis`",
+        ),
+        (
+            write(
+                "needs.toml",
+                "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n[[effect]]\nname = \"scale_factor_temperature\"\nppm_per_c = 1.0\n",
+            ),
+            "",
+            "needs column(s) `temp_c`",
+        ),
+    ];
+    for (model, pos, what) in cases {
+        let (code, _, err) = lab(&[
+            "discover",
+            "--gyro",
+            "fog",
+            "--model",
+            &model,
+            "--data",
+            &p(&run),
+            "--out",
+            &p(&d.join("o")),
+        ]);
+        assert_eq!(code, 2, "{model}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        let file = if what.starts_with("needs") {
+            p(&run)
+        } else {
+            model.clone()
+        };
+        assert!(err.contains(&format!("{file}{pos}")), "{err}");
+        assert!(err.contains(what), "{err}");
+    }
+    // A library effect whose inputs the run lacks is skipped, and said so.
+    let (code, out, err) = lab(&[
+        "discover",
+        "--gyro",
+        "fog",
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&d.join("o")),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let skipped: Vec<String> = json(&out)["skipped"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["effect"].as_str().unwrap().to_owned())
+        .collect();
+    assert!(
+        skipped.contains(&"scale_factor_temperature".to_owned()),
+        "{skipped:?}"
+    );
+}
