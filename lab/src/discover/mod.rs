@@ -210,21 +210,25 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     let floor_s = noise_at(allan_before.as_ref(), &inp.t, &r, SMOOTH_S);
     let mut disagreements: Vec<Disagreement> = vec![];
     let half = 0.5 * SMOOTH_S;
+    // A window's span, clipped to the record (a record shorter than a window
+    // is one window).
+    let (t_first, t_last) = (inp.t[0], inp.t[inp.t.len() - 1]);
+    let span = |t: f64| ((t - half).max(t_first), (t + half).min(t_last));
     for (i, v) in sm.iter().enumerate() {
         let dph = v * 3600.0;
         if dph.abs() > 3.0 * floor_s {
             let t = smooth.t[i];
             // Stretches a smoothing window or two apart are one.
             match disagreements.last_mut() {
-                Some(d) if t - half <= d.to_s + 2.0 * SMOOTH_S => {
-                    d.to_s = t + half;
+                Some(d) if span(t).0 <= d.to_s + 2.0 * SMOOTH_S => {
+                    d.to_s = span(t).1;
                     if dph.abs() > d.peak_dph.abs() {
                         d.peak_dph = dph;
                     }
                 }
                 _ => disagreements.push(Disagreement {
-                    from_s: t - half,
-                    to_s: t + half,
+                    from_s: span(t).0,
+                    to_s: span(t).1,
                     peak_dph: dph,
                 }),
             }
