@@ -1,6 +1,6 @@
 //! Build script:
 //! - puts memory.x where cortex-m-rt's link.x finds it (MCU builds);
-//! - firmware builds: turns the coefficient files into the CRC-protected
+//! - turns the coefficient files into the CRC-protected
 //!   records the firmware checks at start (gyro-coeffs defines both sides):
 //!   `RLG_COEFFS` (default config/rlg_thermal.toml, from `gyro-lab fit
 //!   thermal`) and `FOG_SF_COEFFS` (default config/fog_scale_factor.toml,
@@ -14,9 +14,6 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
-    if env::var_os("CARGO_FEATURE_FIRMWARE").is_none() {
-        return;
-    }
     for (var, default, bin) in [
         ("RLG_COEFFS", "config/rlg_thermal.toml", "rlg_coeffs.bin"),
         (

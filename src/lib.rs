@@ -1,36 +1,18 @@
-//! Gyro signal processor: the hardware-free DSP core shared by the firmware,
-//! the host tests and the `gyro-lab` tool.
+//! Firmware of the gyro signal processor (STM32F405): the application both
+//! boards share, and the thin glue to the chip. All signal processing is in
+//! `gyro_sp`; one binary per board in `src/bin/`:
+//! - `gyro-fw-qemu` (feature `qemu`): qemu-system-arm `netduinoplus2`, the
+//!   gyro simulated on-chip (`gyro_sim`);
+//! - `gyro-fw-hw` (feature `hw`): the gyro electronics, flashed with probe-rs.
 //!
-//! Everything here is `no_std`, allocation-free and free of defmt, so the code
-//! the host tests exercise is the code that runs in the MCU's interrupts.
-//!
-//! Fixed-point conventions used throughout:
-//! - [`Phase`]: `u32`, one full turn (2*pi rad) is 2^32 LSB, wrapping on purpose.
-//! - ADC samples: `u16`, full scale 65 536 LSB (a 12-bit ADC is left-aligned).
-//! - Modulator DAC codes: `u16`.
+//! The features only pull in each board's crates (logger, simulator), so both
+//! binaries build together (`--features qemu,hw`) and host builds skip them.
 #![no_std]
 
-pub mod derivative;
-pub mod drivers;
-pub mod fog;
-pub mod frame;
-pub mod rlg;
-pub mod sensor;
-pub mod sim;
-
-/// Phase with one turn = 2^32 LSB (wrapping arithmetic is the 2*pi reset).
-pub type Phase = u32;
-
-/// Radians per [`Phase`] LSB.
-pub const RAD_PER_PHASE_LSB: f64 = core::f64::consts::TAU / 4_294_967_296.0;
-
-/// Converts radians to phase LSB (rounded, wrapping to one turn).
-pub fn phase_from_rad(rad: f64) -> Phase {
-    let turns = rad / core::f64::consts::TAU;
-    let frac = turns - libm_floor(turns);
-    (frac * 4_294_967_296.0 + 0.5) as u64 as u32
-}
-
-fn libm_floor(x: f64) -> f64 {
-    num_traits::float::Float::floor(x)
-}
+pub mod app;
+#[cfg(feature = "hw")]
+pub mod i2c;
+#[cfg(feature = "board")]
+pub mod stack;
+#[cfg(feature = "board")]
+pub mod uart;

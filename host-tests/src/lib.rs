@@ -1,8 +1,8 @@
 //! Helpers shared by the host tests: the firmware core closed around the
 //! simulated gyro, with the truth alongside.
 
+use gyro_sim::{FogRig, OpticsParams, Profile, Segment};
 use gyro_sp::fog::{ClosureOutput, FogConfig, FogParams};
-use gyro_sp::sim::{FogRig, OpticsParams, Profile, Segment};
 
 pub const DEG: f64 = std::f64::consts::PI / 180.0;
 pub const DPH: f64 = 3600.0 / DEG;

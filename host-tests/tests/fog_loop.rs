@@ -3,8 +3,8 @@
 //! applied the next step (QEMU, host) and the step after next (the hw DMA
 //! ping-pong, `dac_latency_steps = 1`).
 
+use gyro_sim::{Profile, Segment};
 use gyro_sp::fog::{Faults, FogParams};
-use gyro_sp::sim::{Profile, Segment};
 use host_tests::*;
 
 /// The default instrument with `latency` steps of DAC latency.

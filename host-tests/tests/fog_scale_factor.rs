@@ -2,11 +2,11 @@
 //! its floating-point model (`ScaleFactorTable::eval`), the coil-sensor lead
 //! against a simulated lagging sensor, and the fault paths.
 
+use gyro_sim::CoilThermal;
 use gyro_sp::fog::scale_factor::{
     flags, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable, LEAD_FILTER_TAU_S,
 };
 use gyro_sp::fog::{FogConfig, FogParams};
-use gyro_sp::sim::CoilThermal;
 use proptest::prelude::*;
 
 fn fog() -> FogConfig {

@@ -1,4 +1,4 @@
-//! Epsilon-squared vibration drift (physics.md 1.4): the simulated drift against
+//! Epsilon-squared vibration drift (docs/fog.md): the simulated drift against
 //! the formula, and the online correction.
 //!
 //! These use a 16-bit ADC: with the STM32's 12-bit ADC and no noise the
@@ -173,7 +173,7 @@ fn correction_adds_no_drift_at_rest_with_noise() {
                 o.noise = true;
                 o.seed = seed
             },
-            gyro_sp::sim::Profile::constant(0.0),
+            gyro_sim::Profile::constant(0.0),
         );
         let m = mean_error(&mut r, 100, 100 + 5 * 12_500);
         let moved = m.corrected_dph - m.raw_dph;

@@ -3,9 +3,9 @@
 
 use embedded_hal::i2c::ErrorKind;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gyro_sp::drivers::tmp117::{Tmp117, Tmp117Error, NACK_ADDRESS};
 use gyro_sp::rlg::thermal::{flags, Temperatures, ThermalComp, ThermalConfig};
 use gyro_sp::rlg::ThermalCoeffs;
+use tmp117::{Tmp117, Tmp117Error, NACK_ADDRESS};
 
 const A: u8 = 0x48;
 

@@ -1,5 +1,5 @@
-//! The named physical effects of interfaces.md (`discover`), each the
-//! formula of physics.md written once: what it adds to the gyro's output
+//! The named physical effects of docs/interfaces.md (`discover`), each the
+//! formula written once, here: what it adds to the gyro's output
 //! (deg/s) from the run's inputs. A model (model.rs) evaluates these; the
 //! discovery (discover/) fits them as regressors.
 //!
@@ -14,8 +14,8 @@
 //! | scale_factor_asymmetry | (a/2) 1e-6 abs(w) (scale factor of positive rates exceeds negative by a) | - |
 //! | scale_factor_temperature | k 1e-6 w (T - 20) | temp_c |
 //! | scale_factor_knee | d 1e-6 w max(0, T - T_k) | temp_c |
-//! | vibration_rectification | c eps^2/3600 (eps the angular acceleration, deg/s^2; physics.md 1.4) | ref_acc_dps2 or ref_rate_dps |
-//! | lock_in | sign(w) sqrt(w^2 - W_L^2) - w, or -w inside the lock band (physics.md 2.1) | - |
+//! | vibration_rectification | c eps^2/3600 (eps the angular acceleration, deg/s^2; docs/fog.md) | ref_acc_dps2 or ref_rate_dps |
+//! | lock_in | sign(w) sqrt(w^2 - W_L^2) - w, or -w inside the lock band (docs/rlg.md) | - |
 //! | thermal_difference | k1 dT/3600, dT = t_mono_a - t_mono_b | t_mono_a_c, t_mono_b_c |
 //! | thermal_gradient | k2 grad(dT)/3600 (the firmware's 20 s filtered derivative) | t_mono_a_c, t_mono_b_c |
 //! | thermal_difference_squared | k3 dT^2/3600 | t_mono_a_c, t_mono_b_c |
@@ -350,7 +350,7 @@ impl Effect {
 }
 
 /// The rate an RLG indicates near lock-in: its beat, K sqrt(W^2 - W_L^2)
-/// (physics.md 2.1), with the input's sign; zero inside the lock band.
+/// (docs/rlg.md), with the input's sign; zero inside the lock band.
 pub fn lock_in_output(w: f64, w_l: f64) -> f64 {
     let a = w.abs();
     if a <= w_l {

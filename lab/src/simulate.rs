@@ -3,8 +3,8 @@
 
 use crate::error::LabError;
 use clap::{Args, Subcommand};
+use gyro_sim::{FogRig, OpticsParams, Profile, Segment};
 use gyro_sp::fog::{FogConfig, FogParams};
-use gyro_sp::sim::{FogRig, OpticsParams, Profile, Segment};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 

@@ -1,4 +1,4 @@
-//! Reading run and fringe files (interfaces.md "Data files"): CSV, one header
+//! Reading run and fringe files (docs/interfaces.md "Data files"): CSV, one header
 //! row, `#` comment lines before it. Every cell the tool uses is checked: a
 //! missing column, a cell that is not a finite number, time that does not
 //! increase or too few rows give `file:line:column: message` (column = 1-based

@@ -101,7 +101,7 @@ fn warm_up_from_the_chamber_simulation() {
         &p(&run),
     ]);
     assert_eq!(code, 0, "{err}");
-    let t = gyro_sp::sim::ChamberParams::default().truth;
+    let t = gyro_sim::ChamberParams::default().truth;
     let model = d.join("model.toml");
     std::fs::write(
         &model,

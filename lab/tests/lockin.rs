@@ -1,4 +1,4 @@
-//! Lock-in measurement (physics.md 2.1) on simulated fringe records: the
+//! Lock-in measurement (docs/rlg.md) on simulated fringe records: the
 //! estimator (closed-form periodic solution) against the simulator (numerical
 //! integration of the lock-in equation).
 

@@ -1,4 +1,4 @@
-//! RLG thermal calibration end to end (physics.md 2.3): simulate two chamber
+//! RLG thermal calibration end to end (docs/rlg.md): simulate two chamber
 //! runs with different profiles and orientations, fit on one, compensate the
 //! other with the firmware's fixed-point code through `gyro-lab`.
 
@@ -64,7 +64,7 @@ fn fit_on_one_run_validate_on_another() {
         "--out",
         &p("c.toml"),
     ]);
-    let truth = gyro_sp::sim::ChamberParams::default().truth;
+    let truth = gyro_sim::ChamberParams::default().truth;
     // The well-determined terms come back close to the simulator's truth.
     let c = &fit["coefficients"];
     let near = |k: &str, v: f64, tol: f64| {

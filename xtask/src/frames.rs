@@ -1,12 +1,12 @@
 //! Decoding of the firmware's UART frames into a run file, and the summary.
 
 use anyhow::{Context, Result};
+use gyro_sim::profile::qemu_demo;
+use gyro_sim::ChamberParams;
 use gyro_sp::fog::scale_factor::flags as sf_flags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
 use gyro_sp::rlg::thermal::flags as rlg_flags;
-use gyro_sp::sim::profile::qemu_demo;
-use gyro_sp::sim::ChamberParams;
 use std::io::Write;
 use std::path::Path;
 
@@ -119,7 +119,7 @@ pub fn analyse(path: &Path) -> Result<Report> {
     })
 }
 
-/// The RLG channel's run file (interfaces.md run-file columns).
+/// The RLG channel's run file (docs/interfaces.md run-file columns).
 pub fn write_rlg_run_file(r: &Report, path: &Path) -> Result<()> {
     let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(

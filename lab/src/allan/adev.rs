@@ -1,4 +1,4 @@
-//! Overlapping Allan variance of a rate record (physics.md 3).
+//! Overlapping Allan variance of a rate record (docs/noise.md).
 //!
 //! With theta the angle (cumulative sum of the rate, its mean removed so
 //! the sums stay small), the overlapping estimator at averaging factor m is

@@ -1,5 +1,5 @@
 //! `gyro-lab bench allan`: recovery of known noise terms from the project's
-//! own generators (`gyro_sp::sim::noise`) over seeds, each term alone and
+//! own generators (`gyro_sim::noise`) over seeds, each term alone and
 //! in combinations; `gyro-lab bench allan-speed`: the time for 10^7
 //! samples against the O(N m) definition on 10^5.
 
@@ -7,7 +7,7 @@ use super::terms::{self, COUNT, NAMES, UNITS};
 use super::{adev, analyse};
 use crate::error::LabError;
 use clap::Args;
-use gyro_sp::sim::{NoiseParams, RateNoise};
+use gyro_sim::{NoiseParams, RateNoise};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// A record of known terms: (Q arcsec, N deg/sqrt(h), B deg/h, K

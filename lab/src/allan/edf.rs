@@ -151,16 +151,16 @@ mod tests {
                         .map(|_| StandardNormal.sample(&mut rng))
                         .collect();
                     seed += 1;
-                    let gen = |p: gyro_sp::sim::NoiseParams| {
-                        let mut g = gyro_sp::sim::RateNoise::new(p, 1.0, seed);
+                    let gen = |p: gyro_sim::NoiseParams| {
+                        let mut g = gyro_sim::RateNoise::new(p, 1.0, seed);
                         (0..n).map(|_| g.sample()).collect::<Vec<f64>>()
                     };
                     let y: Vec<f64> = match alpha {
-                        0 => gen(gyro_sp::sim::NoiseParams {
+                        0 => gen(gyro_sim::NoiseParams {
                             n_dps_rts: 1.0,
                             ..Default::default()
                         }),
-                        -2 => gen(gyro_sp::sim::NoiseParams {
+                        -2 => gen(gyro_sim::NoiseParams {
                             k_dps_rts: 1.0,
                             ..Default::default()
                         }),

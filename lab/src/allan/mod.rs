@@ -1,5 +1,5 @@
 //! `gyro-lab allan`: noise analysis of a rate record (IEEE 952 Allan
-//! variance method, physics.md 3): overlapping Allan deviation at
+//! variance method, docs/noise.md): overlapping Allan deviation at
 //! log-spaced averaging times with chi-square intervals from Greenhall's
 //! degrees of freedom, and the noise terms fitted to the whole curve.
 

@@ -1,4 +1,4 @@
-//! The IEEE 952 noise terms (physics.md 3) fitted to a whole Allan-variance
+//! The IEEE 952 noise terms (docs/noise.md) fitted to a whole Allan-variance
 //! curve: `AVAR(tau) = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 +
 //! R^2 tau^2/2`, linear in c = (Q^2, N^2, B^2, K^2, R^2) >= 0.
 //!
@@ -27,7 +27,7 @@ use super::edf::edf_oavar;
 use nalgebra::DMatrix;
 
 pub const COUNT: usize = 5;
-/// JSON names (interfaces.md).
+/// JSON names (docs/interfaces.md).
 pub const NAMES: [&str; COUNT] = [
     "quantization",
     "angle_random_walk_dpsh",

@@ -1,6 +1,6 @@
 //! `gyro-lab discover`: where the model and the measured data disagree, the
 //! named effect that is missing, the model with it added, and the gap
-//! shrinking (physics.md 4).
+//! shrinking (docs/discovery.md).
 //!
 //! 1. The model (model.rs; without `--model` the ideal gyro) is evaluated on
 //!    the run's inputs; the residual is measured minus model.

@@ -1,4 +1,4 @@
-//! Forward selection of named effects (physics.md 4).
+//! Forward selection of named effects (docs/discovery.md).
 //!
 //! The residual (measured minus model) and every effect's regressors are
 //! averaged over the same windows (1 s: the gap's averaging), so the fit is

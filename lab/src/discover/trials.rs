@@ -1,14 +1,14 @@
 //! Runs with known effects for discovery: a truth model (model.rs, the
 //! effects of effects.rs) evaluated on a test profile, plus the project's
-//! noise generator (gyro_sp::sim::noise) and its thermal simulators
-//! (gyro_sp::sim::fog_thermal's coil, gyro_sp::sim::rlg_rig's chamber).
+//! noise generator (gyro_sim::noise) and its thermal simulators
+//! (gyro_sim::fog_thermal's coil, gyro_sim::rlg_rig's chamber).
 //! `gyro-lab simulate run` writes them; the discovery bench and tests draw
 //! them.
 
 use crate::effects::{GyroKind, Inputs};
 use crate::error::LabError;
 use crate::model::Model;
-use gyro_sp::sim::{Chamber, ChamberParams, CoilThermal, NoiseParams, RateNoise};
+use gyro_sim::{Chamber, ChamberParams, CoilThermal, NoiseParams, RateNoise};
 use rand_core::{RngCore, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;

@@ -54,7 +54,7 @@ pub struct Row {
     /// The fit's own one-sigma uncertainty, % (mean over seeds).
     pub exact_std_pct: f64,
     /// The same from both channels of the quadrature pair (the RLG readout
-    /// has two photodiodes, physics.md 2.2): independent noise, so the
+    /// has two photodiodes, docs/rlg.md): independent noise, so the
     /// bound falls by sqrt(2).
     pub pair_rms_pct: f64,
     pub pair_max_pct: f64,

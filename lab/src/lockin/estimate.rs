@@ -1,5 +1,5 @@
 //! Lock-in rate from a fringe record by the exact harmonic relation
-//! (physics.md 2.1).
+//! (docs/rlg.md).
 //!
 //! The periodic solution of the lock-in equation makes `exp(i*psi)` a Moebius
 //! transform of a uniform rotation `z = exp(i*theta)`, `theta = w*t + theta0`:

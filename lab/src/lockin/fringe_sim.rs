@@ -1,4 +1,4 @@
-//! Fringe-signal simulator of an RLG near lock-in (physics.md 2.1): integrates
+//! Fringe-signal simulator of an RLG near lock-in (docs/rlg.md): integrates
 //! `dpsi/dt = 2*pi*K*(Omega_I - Omega_L*sin(psi + beta))` numerically (RK4,
 //! at most 0.05 rad of phase per step) and samples the photodiodes
 //! `S = A*sin(psi) + offset` (and `Q = A*cos(psi) + offset`) with additive white
@@ -35,7 +35,7 @@ pub struct FringeParams {
 }
 
 impl Default for FringeParams {
-    /// The reference conditions of physics.md 2.1 (K = 2000, 20 kHz, 3 s).
+    /// The reference conditions of docs/rlg.md (K = 2000, 20 kHz, 3 s).
     fn default() -> Self {
         Self {
             pulses_per_deg: 2000.0,

@@ -1,4 +1,4 @@
-//! Scale factor over temperature from a calibration run (physics.md 1.5).
+//! Scale factor over temperature from a calibration run (docs/fog.md).
 //!
 //! Model, per sample: `y - w = w * s(T) + b(T)`, with w the reference rate,
 //! y the output (nominal scale factor), s the scale-factor error (relative),

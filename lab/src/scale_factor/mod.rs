@@ -223,7 +223,7 @@ pub struct FitArgs {
     pub json: bool,
 }
 
-/// JSON of `fit scale-factor` (interfaces.md keys first).
+/// JSON of `fit scale-factor` (docs/interfaces.md keys first).
 #[derive(serde::Serialize)]
 struct FitJson<'a> {
     knees_c: Vec<f64>,
@@ -282,7 +282,7 @@ pub fn fit_run(a: &FitArgs) -> Result<(), LabError> {
     gyro_coeffs::file::write(
         &a.out,
         &CoeffFile::fog_scale_factor(&f.table, info),
-        "FOG scale factor and bias over coil temperature (physics.md 1.5), written by gyro-lab fit scale-factor.\n\
+        "FOG scale factor and bias over coil temperature (docs/fog.md), written by gyro-lab fit scale-factor.\n\
          output = (1 + sf_ppm*1e-6)*rate + bias_dph, linear in the coil temperature between the nodes, held outside;\n\
          coil temperature = sensor + sensor_lag_s * d(sensor)/dt. Load with `gyro-lab compensate` or build the\n\
          firmware with FOG_SF_COEFFS=<this file>.",

@@ -4,7 +4,7 @@
 //! (temperature plateaus, each with a rate sequence in both directions).
 //! Rates are in deg/s; one row per sample period, the means over it.
 
-use gyro_sp::sim::{CoilThermal, NoiseParams, RateNoise, ScaleFactorTruth};
+use gyro_sim::{CoilThermal, NoiseParams, RateNoise, ScaleFactorTruth};
 use rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -266,7 +266,7 @@ pub fn simulate(test: &Test, p: &RigParams) -> Run {
     run
 }
 
-/// Writes a run file (interfaces.md) with the truth columns.
+/// Writes a run file (docs/interfaces.md) with the truth columns.
 pub fn write(run: &Run, path: &std::path::Path, comment: &str) -> std::io::Result<()> {
     use std::io::Write;
     let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);

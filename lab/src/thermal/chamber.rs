@@ -1,11 +1,11 @@
 //! `gyro-lab simulate chamber`: an RLG run in a thermal chamber (profiles over
 //! -40..+50 degC) at a fixed orientation, written as a run file. The gyro
-//! model is `gyro_sp::sim::Chamber` (also inside the qemu firmware); this adds
+//! model is `gyro_sim::Chamber` (also inside the qemu firmware); this adds
 //! the chamber profile and the Earth-rate component of the orientation.
 
 use crate::error::LabError;
 use clap::{Args, ValueEnum};
-use gyro_sp::sim::{Chamber, ChamberParams};
+use gyro_sim::{Chamber, ChamberParams};
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -1,4 +1,4 @@
-//! Least-squares fit of the RLG thermal bias model (physics.md 2.3) on a
+//! Least-squares fit of the RLG thermal bias model (docs/rlg.md) on a
 //! chamber run, next to the classic one-sensor cubic; drift figures.
 //!
 //! The regressors are those the firmware computes (thermal.rs), in f64 with

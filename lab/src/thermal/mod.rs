@@ -158,7 +158,7 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
     gyro_coeffs::file::write(
         &a.out,
         &file,
-        "RLG thermal bias model (physics.md 2.3), written by gyro-lab fit thermal.\n\
+        "RLG thermal bias model (docs/rlg.md), written by gyro-lab fit thermal.\n\
          B = bias0 + k1*dT + k2*grad(dT) + k3*dT^2 + k4*T_K + k5*(1 - exp(-t/tau_warm)), deg/h;\n\
          dT = t_mono_a - t_mono_b. Load with `gyro-lab compensate` or build the firmware with RLG_COEFFS=<this file>.",
     )

@@ -1,0 +1,41 @@
+//! Closed-loop fiber-optic gyro: square-wave +-phi0 bias modulation, synchronous
+//! demodulation, digital serrodyne feedback, the 2*pi gain loop and the online
+//! epsilon-squared (vibration rectification) correction. See docs/fog.md.
+//!
+//! Data flow per closure step (one interrupt, `n_half` half periods of tau):
+//! ADC batch -> [`demod`] -> main loop ([`closure`]) and [`gain_loop`] ->
+//! [`modulator`] writes the DAC words of the next step; [`vibration`] corrects
+//! the output; [`faults`] flags what went wrong. At the frame rate,
+//! [`scale_factor`] applies the scale factor and bias over coil temperature.
+
+pub mod closure;
+pub mod config;
+pub mod demod;
+pub mod faults;
+pub mod gain_loop;
+pub mod modulator;
+pub mod scale_factor;
+pub mod vibration;
+
+pub use closure::{ClosureOutput, FogLoop};
+pub use config::{FogConfig, FogParams};
+pub use faults::Faults;
+
+/// Most half periods per closure step (6.25 kHz closure at tau = 5 us is 32).
+pub const MAX_HALF: usize = 64;
+/// Most ADC samples per half period.
+pub const MAX_SAMPLES_PER_HALF: usize = 16;
+
+/// `x >> S` saturated to the signed `B`-bit range (`S + B` in 33..=64, `B` <= 32).
+/// The high word alone decides whether it fits, so this is one `ssat`, a compare
+/// and a select on the M4, not a 64-bit clamp.
+#[inline(always)]
+pub fn shr_saturate<const S: u32, const B: u32>(x: i64) -> i32 {
+    let hi = (x >> 32) as i32;
+    let lim = 1i32 << (S + B - 33);
+    if hi.clamp(-lim, lim - 1) == hi {
+        (x >> S) as i32
+    } else {
+        (hi >> 31) ^ (i32::MAX >> (32 - B))
+    }
+}

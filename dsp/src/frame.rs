@@ -1,0 +1,268 @@
+//! Output frame sent over the USART: fixed size, little-endian, CRC-protected.
+//!
+//! | offset | type | field |
+//! |---|---|---|
+//! | 0 | u8 x2 | sync 0xA5 0x5A |
+//! | 2 | u8 | version (3) |
+//! | 3 | u8 | payload length after this byte, CRC included (82) |
+//! | 4 | u16 | sequence number (wraps) |
+//! | 6 | u16 | fault flags, OR over the frame's steps ([`crate::fog::Faults`]) |
+//! | 8 | u16 | closure steps in this frame |
+//! | 10 | u32 | closure-step counter at the end of the frame (wraps) |
+//! | 14 | i64 | FOG angle increment, corrected: sum of `step_corrected` over every half period (angle LSB = 2*pi/2^32 rad * tau / K_s) |
+//! | 22 | i64 | FOG angle increment without the epsilon-squared correction |
+//! | 30 | i32 | FOG residual of the last step, phase LSB |
+//! | 34 | u32 | 2*pi loop gain, DAC codes per turn, Q8 |
+//! | 38 | u32 | detector DC, kept-sample sum of one half period, ADC LSB |
+//! | 42 | i32 | RLG angle increment, counts (1/K deg, K = counts per degree) |
+//! | 46 | i32 | RLG compensated rate over the frame, micro-deg/s |
+//! | 50 | i32 | RLG thermal bias B_TC in use, Q16 deg/h |
+//! | 54 | i16 x3 | RLG temperatures in use: monoblock A, monoblock B, case; Q8 degC |
+//! | 60 | u8 | RLG flags ([`crate::rlg::thermal::flags`]: sensor A, B, case bad; coefficients refused) |
+//! | 61 | u8 | reserved (0) |
+//! | 62 | i64 | FOG angle increment compensated: the corrected angle with the scale factor and bias over coil temperature applied ([`crate::fog::scale_factor`]), same LSB |
+//! | 70 | i32 | FOG scale-factor correction in use: output times 1 + x/2^32 |
+//! | 74 | i32 | FOG bias removed, Q16 deg/h |
+//! | 78 | i16 | FOG coil temperature the table was read at (sensor plus lag lead), Q8 degC |
+//! | 80 | i16 | FOG coil sensor value in use (held while bad), Q8 degC |
+//! | 82 | u8 | FOG temperature flags ([`crate::fog::scale_factor::flags`]: coil sensor bad, out of the calibrated range, table refused) |
+//! | 83 | u8 | reserved (0) |
+//! | 84 | u16 | CRC-16/CCITT-FALSE over bytes 2..84 |
+//!
+//! Version 1 (44 bytes) was the FOG part alone; version 2 (64 bytes) ended
+//! after byte 61.
+
+use crate::fog::scale_factor::{FogTempWords, ScaleFactorComp, ScaleFactorConfig};
+use crate::rlg::RlgWords;
+use crc::{Crc, CRC_16_IBM_3740};
+
+pub const FRAME_LEN: usize = 86;
+pub const SYNC: [u8; 2] = [0xA5, 0x5A];
+pub const VERSION: u8 = 3;
+const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Frame {
+    pub seq: u16,
+    pub faults: u16,
+    pub steps: u16,
+    pub step_counter: u32,
+    pub fog_angle: i64,
+    pub fog_angle_raw: i64,
+    pub fog_residual: i32,
+    pub codes_per_turn_q8: u32,
+    pub dc: u32,
+    pub rlg: RlgWords,
+    pub fog_angle_comp: i64,
+    pub fog_temp: FogTempWords,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameError {
+    Sync,
+    Version,
+    Length,
+    Crc,
+}
+
+impl Frame {
+    pub fn encode(&self) -> [u8; FRAME_LEN] {
+        let mut b = [0u8; FRAME_LEN];
+        let mut w = Writer {
+            buf: &mut b,
+            pos: 0,
+        };
+        w.put(&SYNC);
+        w.put(&[VERSION, (FRAME_LEN - 4) as u8]);
+        w.put(&self.seq.to_le_bytes());
+        w.put(&self.faults.to_le_bytes());
+        w.put(&self.steps.to_le_bytes());
+        w.put(&self.step_counter.to_le_bytes());
+        w.put(&self.fog_angle.to_le_bytes());
+        w.put(&self.fog_angle_raw.to_le_bytes());
+        w.put(&self.fog_residual.to_le_bytes());
+        w.put(&self.codes_per_turn_q8.to_le_bytes());
+        w.put(&self.dc.to_le_bytes());
+        let g = &self.rlg;
+        w.put(&g.delta_counts.to_le_bytes());
+        w.put(&g.rate_comp_udps.to_le_bytes());
+        w.put(&g.bias_q16_dph.to_le_bytes());
+        w.put(&g.t_mono_a_q8.to_le_bytes());
+        w.put(&g.t_mono_b_q8.to_le_bytes());
+        w.put(&g.t_case_q8.to_le_bytes());
+        w.put(&[g.flags, 0]);
+        w.put(&self.fog_angle_comp.to_le_bytes());
+        let t = &self.fog_temp;
+        w.put(&t.sf_corr_q32.to_le_bytes());
+        w.put(&t.bias_q16_dph.to_le_bytes());
+        w.put(&t.t_coil_q8.to_le_bytes());
+        w.put(&t.t_sensor_q8.to_le_bytes());
+        w.put(&[t.flags, 0]);
+        let crc = CRC16.checksum(b.get(2..FRAME_LEN - 2).unwrap_or(&[]));
+        if let Some(t) = b.get_mut(FRAME_LEN - 2..) {
+            t.copy_from_slice(&crc.to_le_bytes());
+        }
+        b
+    }
+
+    pub fn decode(b: &[u8]) -> Result<Self, FrameError> {
+        let b: &[u8; FRAME_LEN] = b
+            .get(..FRAME_LEN)
+            .and_then(|s| s.try_into().ok())
+            .ok_or(FrameError::Length)?;
+        if b[..2] != SYNC {
+            return Err(FrameError::Sync);
+        }
+        if b[2] != VERSION {
+            return Err(FrameError::Version);
+        }
+        if b[3] as usize != FRAME_LEN - 4 {
+            return Err(FrameError::Length);
+        }
+        let crc = u16::from_le_bytes([b[FRAME_LEN - 2], b[FRAME_LEN - 1]]);
+        if CRC16.checksum(&b[2..FRAME_LEN - 2]) != crc {
+            return Err(FrameError::Crc);
+        }
+        let mut r = Reader { buf: b, pos: 4 };
+        Ok(Self {
+            seq: u16::from_le_bytes(r.take()),
+            faults: u16::from_le_bytes(r.take()),
+            steps: u16::from_le_bytes(r.take()),
+            step_counter: u32::from_le_bytes(r.take()),
+            fog_angle: i64::from_le_bytes(r.take()),
+            fog_angle_raw: i64::from_le_bytes(r.take()),
+            fog_residual: i32::from_le_bytes(r.take()),
+            codes_per_turn_q8: u32::from_le_bytes(r.take()),
+            dc: u32::from_le_bytes(r.take()),
+            rlg: RlgWords {
+                delta_counts: i32::from_le_bytes(r.take()),
+                rate_comp_udps: i32::from_le_bytes(r.take()),
+                bias_q16_dph: i32::from_le_bytes(r.take()),
+                t_mono_a_q8: i16::from_le_bytes(r.take()),
+                t_mono_b_q8: i16::from_le_bytes(r.take()),
+                t_case_q8: i16::from_le_bytes(r.take()),
+                flags: r.take::<1>()[0],
+            },
+            fog_angle_comp: {
+                r.pos += 1; // reserved byte 61
+                i64::from_le_bytes(r.take())
+            },
+            fog_temp: FogTempWords {
+                sf_corr_q32: i32::from_le_bytes(r.take()),
+                bias_q16_dph: i32::from_le_bytes(r.take()),
+                t_coil_q8: i16::from_le_bytes(r.take()),
+                t_sensor_q8: i16::from_le_bytes(r.take()),
+                flags: r.take::<1>()[0],
+            },
+        })
+    }
+
+    /// Fills the compensated FOG angle and its words from the frame's
+    /// corrected angle (at frame completion, so a frame merged back after a
+    /// full queue is compensated whole).
+    pub fn compensate_fog(&mut self, sf: &ScaleFactorComp, cfg: &ScaleFactorConfig) {
+        let (angle, words) = sf.compensate(cfg, self.fog_angle, self.steps);
+        self.fog_angle_comp = angle;
+        self.fog_temp = words;
+    }
+}
+
+struct Writer<'a> {
+    buf: &'a mut [u8],
+    pos: usize,
+}
+impl Writer<'_> {
+    fn put(&mut self, bytes: &[u8]) {
+        if let Some(d) = self.buf.get_mut(self.pos..self.pos + bytes.len()) {
+            d.copy_from_slice(bytes);
+        }
+        self.pos += bytes.len();
+    }
+}
+struct Reader<'a> {
+    buf: &'a [u8],
+    pos: usize,
+}
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let mut out = [0u8; N];
+        if let Some(s) = self.buf.get(self.pos..self.pos + N) {
+            out.copy_from_slice(s);
+        }
+        self.pos += N;
+        out
+    }
+}
+
+/// Accumulates closure steps into frames: angle increments are summed exactly,
+/// so a frame that could not be sent is merged back and nothing is lost.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameBuilder {
+    acc: Frame,
+    steps_per_frame: u16,
+    n_half: i64,
+    next_seq: u16,
+}
+
+impl FrameBuilder {
+    pub fn new(steps_per_frame: u16, n_half: usize) -> Self {
+        Self {
+            acc: Frame::default(),
+            steps_per_frame: steps_per_frame.max(1),
+            n_half: n_half as i64,
+            next_seq: 0,
+        }
+    }
+
+    /// Adds one closure step; returns a complete frame every `steps_per_frame` steps.
+    pub fn push(&mut self, out: &crate::fog::ClosureOutput, step_counter: u32) -> Option<Frame> {
+        let a = &mut self.acc;
+        a.steps = a.steps.saturating_add(1);
+        a.faults |= out.faults.0;
+        a.step_counter = step_counter;
+        a.fog_angle = a
+            .fog_angle
+            .wrapping_add(out.step_corrected.wrapping_mul(self.n_half));
+        a.fog_angle_raw = a
+            .fog_angle_raw
+            .wrapping_add(out.step.wrapping_mul(self.n_half));
+        a.fog_residual = out.residual;
+        a.codes_per_turn_q8 = out.codes_per_turn_q8;
+        a.dc = out.dc;
+        if a.steps >= self.steps_per_frame {
+            let mut f = core::mem::take(a);
+            f.seq = self.next_seq;
+            self.next_seq = self.next_seq.wrapping_add(1);
+            Some(f)
+        } else {
+            None
+        }
+    }
+
+    /// True when the next closure pushed completes a frame.
+    pub fn completes_next(&self) -> bool {
+        self.acc.steps.saturating_add(1) >= self.steps_per_frame
+    }
+
+    /// Puts the RLG words of this frame in (counts add up, the rest is latest).
+    pub fn set_rlg(&mut self, w: RlgWords) {
+        let d = self.acc.rlg.delta_counts;
+        self.acc.rlg = RlgWords {
+            delta_counts: d.wrapping_add(w.delta_counts),
+            ..w
+        };
+    }
+
+    /// Takes back a frame that could not be queued: its steps go into the next
+    /// frame (flagged), which reuses its sequence number, so no angle is lost.
+    pub fn restore(&mut self, f: Frame) {
+        let a = &mut self.acc;
+        a.steps = a.steps.saturating_add(f.steps);
+        a.faults |= f.faults | crate::fog::Faults::QUEUE_FULL;
+        a.fog_angle = a.fog_angle.wrapping_add(f.fog_angle);
+        a.fog_angle_raw = a.fog_angle_raw.wrapping_add(f.fog_angle_raw);
+        a.rlg.delta_counts = a.rlg.delta_counts.wrapping_add(f.rlg.delta_counts);
+        a.rlg.flags |= f.rlg.flags;
+        self.next_seq = f.seq;
+    }
+}

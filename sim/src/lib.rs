@@ -1,0 +1,20 @@
+//! The simulated gyro: the same model on the host (f64) and inside the `qemu`
+//! firmware (f32). Generic over the float type through `num_traits::Float`
+//! (libm underneath, accurate to the last bit or two; no micromath here because
+//! the second-order fringe terms need full precision).
+
+#![no_std]
+
+pub mod fog_optics;
+pub mod fog_rig;
+pub mod fog_thermal;
+pub mod noise;
+pub mod profile;
+pub mod rlg_rig;
+
+pub use fog_optics::{FogOptics, OpticsParams};
+pub use fog_rig::FogRig;
+pub use fog_thermal::{CoilThermal, ScaleFactorTruth};
+pub use noise::{NoiseParams, RateNoise};
+pub use profile::{Profile, Segment};
+pub use rlg_rig::{Chamber, ChamberParams, ChamberSample};
