@@ -5,9 +5,11 @@
 
 #![allow(clippy::needless_range_loop)] // per-term parallel arrays
 
+mod common;
+use common::lab;
+
 use gyro_lab::allan::bench::{record, SAMPLES, SCENARIOS, TAU0_S};
 use gyro_lab::allan::{analyse, terms};
-use std::process::Command;
 
 #[test]
 fn known_terms_recovered_and_absent_ones_not_reported() {
@@ -64,22 +66,8 @@ fn bias_instability_uses_the_0_664_factor() {
     assert!((floor / b - 0.664).abs() < 0.03, "floor {floor} for B {b}");
 }
 
-fn lab(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
-        .args(args)
-        .output()
-        .expect("run gyro-lab");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("gyro-lab-allan-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::dir(&format!("allan-{name}"))
 }
 
 fn write_run(path: &std::path::Path, y: &[f64], tau0: f64) {

@@ -2,33 +2,17 @@
 //! randomized trial of every effect (the 264-trial figures are `cargo lab
 //! bench discover`'s), the files and JSON it promises, and bad input.
 
+mod common;
+use common::{json, lab};
+
 use gyro_lab::discover::bench::{draw, trial};
 use gyro_lab::discover::trials::TestProfile;
 use gyro_lab::effects::{Effect, GyroKind};
 use gyro_lab::model::Model;
 use rand_core::SeedableRng;
-use std::process::Command;
-
-fn lab(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
-        .args(args)
-        .output()
-        .expect("run gyro-lab");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("gyro-lab-discover-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn json(stdout: &str) -> serde_json::Value {
-    serde_json::from_str(stdout.lines().last().unwrap()).unwrap()
+    common::dir(&format!("discover-{name}"))
 }
 
 #[test]

@@ -2,10 +2,12 @@
 //! truth, the compensation through the firmware's fixed-point code, and the
 //! command line's contract (bad input: one line, exit 2).
 
+mod common;
+use common::lab;
+
 use gyro_lab::scale_factor::bench::{continuous_fit_test, multipoint_test, validation_test};
 use gyro_lab::scale_factor::sim::{simulate, RigParams, Run};
 use gyro_lab::scale_factor::{compensate_rows, fit, fit_run_data};
-use std::process::Command;
 
 fn input(run: &Run) -> fit::SfInput {
     fit::prepare(&run.t_s, &run.ref_rate_dps, &run.rate_dps, &run.temp_c)
@@ -105,22 +107,8 @@ fn multipoint_brackets_the_knee_and_measures_asymmetry() {
     assert!(f.nonlinearity_ppm.is_some());
 }
 
-fn lab(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
-        .args(args)
-        .output()
-        .expect("run gyro-lab");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn dir() -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("gyro-lab-sf-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::dir("sf")
 }
 
 #[test]
