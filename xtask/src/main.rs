@@ -164,7 +164,7 @@ fn test_cmd() -> Result<()> {
         .arg("clippy")
         .args(FIRMWARE)
         .args(["--lib", "--", "-D", "warnings"]))?;
-    run(cargo().args(["test", "--workspace", "--release"]))?;
+    run(cargo().args(["test", "--workspace", "--profile", "host-test"]))?;
     build_firmware("hw")?;
     // Tests of the firmware under QEMU.
     let run = run_qemu()?;
