@@ -41,8 +41,8 @@ pub static FOG_SF_RECORD: [u8; FOG_SF_RECORD_LEN] =
 pub struct FramePath {
     frames: FrameBuilder,
     tx: Producer<'static, Frame, FRAME_QUEUE_LEN>,
-    pub sf_cfg: ScaleFactorConfig,
-    pub sf: ScaleFactorComp,
+    sf_cfg: ScaleFactorConfig,
+    sf: ScaleFactorComp,
     closures: u32,
 }
 
@@ -59,11 +59,6 @@ impl FramePath {
             sf: ScaleFactorComp::default(),
             closures: 0,
         }
-    }
-
-    /// Closures so far (wrapping).
-    pub fn closures(&self) -> u32 {
-        self.closures
     }
 
     /// True when the closure about to be pushed completes a frame: the
