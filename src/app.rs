@@ -5,7 +5,7 @@
 use gyro_coeffs::fog_scale_factor::RECORD_LEN as FOG_SF_RECORD_LEN;
 use gyro_coeffs::rlg_thermal::RECORD_LEN as RLG_RECORD_LEN;
 use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig};
-use gyro_sp::fog::ClosureOutput;
+use gyro_sp::fog::{ClosureOutput, FogParams, MAX_HALF, MAX_SAMPLES_PER_HALF};
 use gyro_sp::frame::{Frame, FrameBuilder};
 use gyro_sp::rlg::RlgWords;
 use heapless::spsc::{Producer, Queue};
@@ -15,8 +15,39 @@ pub const FRAME_QUEUE_LEN: usize = 8;
 /// Frames from the closure interrupt to the main loop.
 pub type FrameQueue = Queue<Frame, FRAME_QUEUE_LEN>;
 
+/// RLG frame words from the RLG update task to the closure: the RLG task
+/// never takes a lock the closure needs.
+pub const RLG_QUEUE_LEN: usize = 4;
+pub type RlgQueue = Queue<RlgWords, RLG_QUEUE_LEN>;
+
 /// FOG closure rate, Hz: one closure interrupt per modulation period.
 pub const CLOSURE_HZ: u32 = 12_500;
+/// The FOG layout, which also sizes the hw board's DMA buffers: half
+/// periods of the bias modulation per closure (12.5 kHz x 16 = 200 kHz, tau
+/// = 5 us, the reference coil's transit time) and ADC samples per half period.
+pub const HALF_PERIODS: usize = 16;
+pub const SAMPLES_PER_HALF: usize = 4;
+/// ADC samples per closure.
+pub const ADC_PER_CLOSURE: usize = HALF_PERIODS * SAMPLES_PER_HALF;
+// Whole +-phi0 pairs in each half of a closure, within the core's buffers.
+const _: () = assert!(
+    HALF_PERIODS.is_multiple_of(4)
+        && HALF_PERIODS <= MAX_HALF
+        && SAMPLES_PER_HALF <= MAX_SAMPLES_PER_HALF
+);
+
+/// The FOG parameters of both boards: the reference instrument with this
+/// layout, and `dac_latency` closures of DAC latency (the hw ping-pong: 1).
+pub fn fog_params(dac_latency: u32) -> FogParams {
+    FogParams {
+        closure_hz: CLOSURE_HZ as f64,
+        tau_s: 1.0 / (CLOSURE_HZ as f64 * HALF_PERIODS as f64),
+        samples_per_half: SAMPLES_PER_HALF,
+        dac_latency_steps: dac_latency,
+        ..FogParams::default()
+    }
+}
+
 /// Closures per output frame: 25 at 12.5 kHz gives 500 frames/s (22 kB/s).
 pub const CLOSURES_PER_FRAME: u16 = 25;
 /// RLG update interrupt rate (counter read + compensation), Hz: one per frame.

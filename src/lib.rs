@@ -11,7 +11,7 @@
 
 pub mod app;
 #[cfg(feature = "hw")]
-pub mod i2c;
+pub mod sampling;
 #[cfg(feature = "board")]
 pub mod stack;
 #[cfg(feature = "board")]

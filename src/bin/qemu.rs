@@ -1,10 +1,17 @@
-//! `qemu` board: netduinoplus2 (STM32F405) in qemu-system-arm. The gyro is
-//! simulated on-chip with the same model as on the host (in f32); SysTick at
-//! 12.5 kHz runs one closure step per interrupt. Under `-icount shift=0` one
-//! instruction is 1 ns of virtual time, so the run is deterministic and SysTick
-//! (core clock) measures the closure's instruction count.
+//! `qemu` board: netduinoplus2 (STM32F405) in qemu-system-arm, on RTIC 2 like
+//! the hw board. The gyro is simulated on-chip with the same model as on the
+//! host (in f32). The closure task is bound to SysTick at 12.5 kHz (highest
+//! priority): QEMU models neither the ADC's DMA nor the RCC (its ready bits
+//! read 0, so the HAL's clock setup would wait forever), so this board keeps
+//! the reset clocks and a core timer. Under `-icount shift=0` one instruction
+//! is 1 ns of virtual time, so the run is deterministic and SysTick (core
+//! clock) counts instructions.
 //!
-//! The RLG channel runs at every frame boundary (500 Hz): a simulated chamber
+//! The RLG update is a lower-priority task bound to TIM5, as on the hw board,
+//! pended once per frame (500 Hz) by the idle loop at a phase that sweeps the
+//! closure period, so some closures arrive while it runs: the closure's
+//! latency (SysTick wrap to its last DAC word) is measured with and without
+//! the RLG update in progress. A simulated chamber
 //! (`sim::Chamber`, the same model as `gyro-lab simulate chamber`) turns the
 //! profile's rate into encoder counts, and three simulated TMP117s answer on
 //! a simulated I2C bus through the real driver. The case sensor stops
@@ -24,31 +31,30 @@
 #![no_std]
 #![no_main]
 
-use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, Ordering};
-use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
-use cortex_m_rt::exception;
 use defmt_semihosting as _;
 use gyro_fw::app::{
-    FramePath, FrameQueue, CLOSURES_PER_FRAME, CLOSURE_HZ, FOG_SF_RECORD, RLG_HZ, RLG_RECORD,
-    SENSOR_EVERY,
+    fog_params, FramePath, FrameQueue, RlgQueue, CLOSURES_PER_FRAME, CLOSURE_HZ, FOG_SF_RECORD,
+    RLG_HZ, RLG_RECORD, SAMPLES_PER_HALF, SENSOR_EVERY,
 };
 use gyro_fw::{stack, uart};
 use gyro_sim::{
-    profile::qemu_demo, Chamber, ChamberParams, CoilThermal, FogRig, OpticsParams, ScaleFactorTruth,
+    profile::qemu_demo, Chamber, ChamberParams, CoilThermal, FogRig, OpticsParams, Profile,
+    ScaleFactorTruth,
 };
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
-use gyro_sp::fog::{Faults, FogConfig, FogParams};
+use gyro_sp::fog::{Faults, FogConfig};
 use gyro_sp::frame::FrameBuilder;
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{RlgChannel, RlgConfig};
+use heapless::spsc::{Consumer, Producer};
 use tmp117::Tmp117;
 
 /// SysTick clock of the emulated STM32F405 (QEMU's SYSCLK).
 const CORE_HZ: u32 = 168_000_000;
 const RELOAD: u32 = CORE_HZ / CLOSURE_HZ - 1;
-/// Optical power loss injected during these steps (the final rest segment).
+/// Optical power loss injected during these closures (the final rest segment).
 const POWER_LOSS: core::ops::Range<u32> = 28_500..28_750;
 /// The case sensor NACKs during these RLG updates (1.0 .. 1.3 s).
 const CASE_NACK: core::ops::Range<u32> = 500..650;
@@ -60,12 +66,38 @@ const COIL_RATE_C_PER_S: f64 = 24.0;
 /// TMP117 address of the FOG coil sensor (the fourth ADD0 address).
 const COIL_SENSOR: u8 = 0x4B;
 
+/// Set by the closure after its last closure; the idle loop then reports.
+static DONE: AtomicBool = AtomicBool::new(false);
+/// Set by the closure `RLG_LEAD` closures before a frame ends: the idle loop
+/// pends the RLG update, which must deliver before the frame completes (the
+/// simulated chamber makes the task several closure periods long).
+static RLG_DUE: AtomicBool = AtomicBool::new(false);
+/// True while the RLG update task runs (the closure's latency is binned by it).
+static RLG_RUNNING: AtomicBool = AtomicBool::new(false);
+/// True while the idle loop sleeps: QEMU's wake from WFI skews SysTick's
+/// count (it reads as if the wrap had just happened a period late), so
+/// those closures' latency is not measured.
+static SLEEPING: AtomicBool = AtomicBool::new(false);
+/// Closures between pending the RLG update and the frame's end.
+const RLG_LEAD: u32 = 12;
+/// Closures before the frame's end at which the closure starts it itself.
+const RLG_LAST_START: u32 = 6;
+
 /// Simulated TMP117s on one I2C bus: they answer temperature reads with the
 /// chamber's readings; one address can be made to NACK.
 struct SimI2c {
     /// 0x48 monoblock A, 0x49 monoblock B, 0x4A case, 0x4B FOG coil.
     temps_c: [f64; 4],
     nack: Option<u8>,
+}
+
+impl SimI2c {
+    fn new() -> Self {
+        Self {
+            temps_c: [20.0; 4],
+            nack: None,
+        }
+    }
 }
 
 impl embedded_hal::i2c::ErrorType for SimI2c {
@@ -94,20 +126,28 @@ impl embedded_hal::i2c::I2c for SimI2c {
     }
 }
 
-struct Rlg {
+/// The RLG update task's state: the channel, the simulated chamber on the
+/// same rate profile, and its three sensors.
+pub struct Rlg {
     cfg: RlgConfig,
     ch: RlgChannel,
     chamber: Chamber,
+    profile: Profile<f32>,
     bus: SimI2c,
     sensors: [Tmp117; 3],
     updates: u32,
+    bench: Bench,
+    /// The whole task, simulated chamber included (preemptions included).
+    task: Bench,
+    words: Producer<'static, gyro_sp::rlg::RlgWords, { gyro_fw::app::RLG_QUEUE_LEN }>,
 }
 
-/// The FOG's temperature: truth, coil sensor and the table's state.
-struct FogThermal {
+/// The FOG's temperature: truth, coil and its sensor.
+pub struct FogThermal {
     truth: ScaleFactorTruth,
     coil: CoilThermal,
     sensor: Tmp117,
+    bus: SimI2c,
 }
 
 /// Coil temperature at closure time `t_s`, degC.
@@ -115,7 +155,9 @@ fn coil_at(t_s: f64) -> f64 {
     COIL_START_C + COIL_RATE_C_PER_S * t_s
 }
 
-struct Bench {
+/// SysTick ticks of timed sections: mean and worst.
+#[derive(Clone, Copy, Default)]
+pub struct Bench {
     ticks_sum: u64,
     ticks_max: u32,
     n: u32,
@@ -124,251 +166,359 @@ struct Bench {
 impl Bench {
     /// One timed section between two SysTick reads.
     fn record(&mut self, t0: u32, t1: u32) {
-        // SysTick counts down and reloads at 0: a reload in between adds RELOAD + 1.
-        let ticks = if t1 <= t0 {
-            t0 - t1
-        } else {
-            t0 + RELOAD + 1 - t1
-        };
+        self.add(ticks_between(t0, t1));
+    }
+
+    fn add(&mut self, ticks: u32) {
         self.ticks_sum += ticks as u64;
         self.ticks_max = self.ticks_max.max(ticks);
         self.n += 1;
     }
-}
 
-struct Ctx {
-    rig: FogRig<f32>,
-    rlg: Rlg,
-    rlg_bench: Bench,
-    fog_thermal: FogThermal,
-    sf_bench: Bench,
-    sf_sensor_bench: Bench,
-    out: FramePath,
-    counter: u32,
-    total: u32,
-    bench: Bench,
-}
-
-static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
-static DONE: AtomicBool = AtomicBool::new(false);
-
-fn run() -> ! {
-    stack::paint();
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
-        fail()
-    };
-    let Some(dp) = stm32f4::stm32f405::Peripherals::take() else {
-        fail()
-    };
-    uart::init(&dp.USART1, 42);
-    let ipt = instructions_per_tick(&mut cp.SYST);
-
-    let mut optics = OpticsParams::<f32>::nominal(5e-6, 4, 49_152);
-    optics.adc_bits = 12;
-    let params = optics.matched(FogParams::default());
-    let Ok(cfg) = FogConfig::new(params) else {
-        fail()
-    };
-    let (profile, _) = qemu_demo::<f32>();
-    let total = (profile.total_duration() * CLOSURE_HZ as f32) as u32;
-    let Some(queue) = cortex_m::singleton!(: FrameQueue = FrameQueue::new()) else {
-        fail()
-    };
-    let (tx, mut rx) = queue.split();
-    let thermal = ThermalConfig::from_record(&RLG_RECORD, SENSOR_EVERY as f64 / RLG_HZ as f64);
-    if thermal.coeffs_default {
-        defmt::warn!("RLG coefficient record refused: running without thermal compensation");
-    }
-    let chamber_p = ChamberParams::default();
-    let rlg = Rlg {
-        cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ),
-        ch: RlgChannel::default(),
-        chamber: Chamber::new(chamber_p, 20.0),
-        bus: SimI2c {
-            temps_c: [20.0; 4],
-            nack: None,
-        },
-        sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
-        updates: 0,
-    };
-    // One coil sensor read per frame, 2 s of thermal time.
-    let sensor_dt_s = THERMAL_TIME_SCALE * CLOSURES_PER_FRAME as f64 / CLOSURE_HZ as f64;
-    let fog_thermal = FogThermal {
-        truth: ScaleFactorTruth::default(),
-        coil: CoilThermal::new(COIL_START_C),
-        sensor: Tmp117::new(COIL_SENSOR),
-    };
-    let sf_cfg = ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, sensor_dt_s);
-    if sf_cfg.coeffs_refused {
-        defmt::warn!("FOG scale-factor record refused: running without temperature compensation");
-    }
-    let bench = || Bench {
-        ticks_sum: 0,
-        ticks_max: 0,
-        n: 0,
-    };
-    cortex_m::interrupt::free(|cs| {
-        // The rig (2.6 kB) is built in place, not moved in from a local.
-        CTX.borrow(cs).replace(Some(Ctx {
-            rig: FogRig::new(cfg, optics, profile),
-            rlg,
-            rlg_bench: bench(),
-            fog_thermal,
-            sf_bench: bench(),
-            sf_sensor_bench: bench(),
-            out: FramePath::new(
-                FrameBuilder::new(CLOSURES_PER_FRAME, cfg.n_half),
-                tx,
-                sf_cfg,
-            ),
-            counter: 0,
-            total,
-            bench: bench(),
-        }));
-        if let Some(c) = CTX.borrow(cs).borrow_mut().as_mut() {
-            set_fog_truth(&mut c.rig, &c.fog_thermal.truth, 0.5 / RLG_HZ as f64);
-        }
-    });
-    defmt::info!(
-        "gyro-fw qemu: FOG closure at {} Hz, {} steps, frames every {} steps",
-        CLOSURE_HZ,
-        total,
-        CLOSURES_PER_FRAME
-    );
-
-    let syst = &mut cp.SYST;
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(RELOAD);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
-
-    let mut sent = 0u32;
-    loop {
-        while let Some(f) = rx.dequeue() {
-            uart::write(&dp.USART1, &f.encode());
-            sent += 1;
-        }
-        if DONE.load(Ordering::Acquire) && !rx.ready() {
-            break;
-        }
-        cortex_m::asm::wfi();
-    }
-    syst.disable_interrupt();
-    let [(sum, max, n), (rsum, rmax, rn), (fsum, fmax, fn_), (ssum, smax, sn)] =
-        cortex_m::interrupt::free(|cs| {
-            CTX.borrow(cs)
-                .borrow()
-                .as_ref()
-                .map_or([(0, 0, 0); 4], |c| {
-                    [&c.bench, &c.rlg_bench, &c.sf_bench, &c.sf_sensor_bench]
-                        .map(|b| (b.ticks_sum, b.ticks_max, b.n))
-                })
-        });
-    let mean_instr = sum as f32 / n.max(1) as f32 * ipt;
-    defmt::info!("frames sent: {}", sent);
-    defmt::info!(
-        "bench: fog_closure_instructions={} max={} stack_bytes={}",
-        mean_instr as u32,
-        (max as f32 * ipt) as u32,
-        stack::high_water()
-    );
-    defmt::info!(
-        "bench: rlg_update_instructions={} rlg_max={}",
-        (rsum as f32 / rn.max(1) as f32 * ipt) as u32,
-        (rmax as f32 * ipt) as u32
-    );
-    defmt::info!(
-        "bench: fog_sf_frame_instructions={} sf_frame_max={} fog_sf_sensor_instructions={} sf_sensor_max={}",
-        (fsum as f32 / fn_.max(1) as f32 * ipt) as u32,
-        (fmax as f32 * ipt) as u32,
-        (ssum as f32 / sn.max(1) as f32 * ipt) as u32,
-        (smax as f32 * ipt) as u32
-    );
-    cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_SUCCESS);
-    loop {
-        cortex_m::asm::wfi();
+    /// (mean, max) in instructions.
+    fn instructions(&self, ipt: f32) -> (u32, u32) {
+        (
+            (self.ticks_sum as f32 / self.n.max(1) as f32 * ipt) as u32,
+            (self.ticks_max as f32 * ipt) as u32,
+        )
     }
 }
 
-#[cortex_m_rt::entry]
-fn main() -> ! {
-    run()
-}
-
-#[exception]
-fn SysTick() {
-    cortex_m::interrupt::free(|cs| {
-        if let Some(ctx) = CTX.borrow(cs).borrow_mut().as_mut() {
-            closure(ctx);
-        }
-    });
-}
-
-fn closure(ctx: &mut Ctx) {
-    if ctx.counter >= ctx.total {
-        DONE.store(true, Ordering::Release);
-        return;
-    }
-    ctx.rig.optics.p.power = if POWER_LOSS.contains(&ctx.counter) {
-        0.05
+/// SysTick ticks from reading `t0` to reading `t1`: it counts down and
+/// reloads at 0, so a reload in between adds RELOAD + 1.
+fn ticks_between(t0: u32, t1: u32) -> u32 {
+    if t1 <= t0 {
+        t0 - t1
     } else {
-        1.0
-    };
-    let truth = ctx.rig.simulate_optics();
-    let t0 = SYST::get_current();
-    let out = ctx.rig.process_core();
-    let t1 = SYST::get_current();
-    ctx.bench.record(t0, t1);
-    ctx.rig.finish_step(out, truth);
-    ctx.counter += 1;
-    if out.faults.has(Faults::OPTICAL_POWER_LOW) && ctx.counter == POWER_LOSS.start + 1 {
-        defmt::warn!("optical power low at step {}", ctx.counter);
-    }
-    if ctx.out.frame_ends() {
-        rlg_update(ctx);
-        fog_thermal_update(ctx);
-    }
-    if let Some(mut f) = ctx.out.push(&out) {
-        // The frame path's work: the scale-factor table at the coil
-        // temperature, applied to the frame's angle.
-        let t0 = SYST::get_current();
-        ctx.out.compensate(&mut f);
-        let t1 = SYST::get_current();
-        ctx.sf_bench.record(t0, t1);
-        ctx.out.send(f);
+        t0 + RELOAD + 1 - t1
     }
 }
 
-/// One RLG update: the chamber advances one update period, the counter is
-/// read; on sensor ticks the three TMP117s are read and the compensation runs
-/// (what the bench times: counter read + compensation, the update interrupt's
-/// work). The frame gets the RLG words.
-fn rlg_update(ctx: &mut Ctx) {
-    let r = &mut ctx.rlg;
-    let dt = 1.0 / RLG_HZ as f64;
-    let t_mid = (r.updates as f64 + 0.5) * dt;
-    let rate_dps = ctx.rig.profile.rate_at(t_mid as f32) as f64 * (180.0 / core::f64::consts::PI);
-    let s = r.chamber.step(dt, 20.0, rate_dps);
-    r.bus.temps_c[..3].copy_from_slice(&[s.t_mono_a_c, s.t_mono_b_c, s.t_case_c]);
-    r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
-    let temps = r
-        .updates
-        .is_multiple_of(SENSOR_EVERY)
-        .then(|| Temperatures {
-            mono_a_q8: r.sensors[0].read(&mut r.bus),
-            mono_b_q8: r.sensors[1].read(&mut r.bus),
-            case_q8: r.sensors[2].read(&mut r.bus),
-        });
-    let t0 = SYST::get_current();
-    r.ch.update(&r.cfg, s.counter, temps.as_ref());
-    let t1 = SYST::get_current();
-    if temps.is_some() {
-        ctx.rlg_bench.record(t0, t1);
+/// What the closure task measures.
+#[derive(Clone, Copy, Default)]
+pub struct ClosureBenches {
+    /// The closure step (the FOG core alone).
+    core: Bench,
+    /// Scale-factor table per frame and per coil reading.
+    sf_frame: Bench,
+    sf_sensor: Bench,
+    /// SysTick wrap (the interrupt raised) to the closure's last DAC word,
+    /// the simulated optics excluded: closures with the RLG update running
+    /// or pending at entry, and those that found the idle loop busy.
+    latency_under_rlg: Bench,
+    latency_alone: Bench,
+}
+
+#[rtic::app(device = stm32f4::stm32f405, peripherals = true)]
+mod app {
+    use super::*;
+
+    #[shared]
+    struct Shared {
+        /// Filled once at the end, read by idle for the summary.
+        closure_benches: Option<ClosureBenches>,
+        rlg_bench: Option<(Bench, Bench)>,
     }
-    r.updates += 1;
-    let (counts, n) = r.ch.take_frame();
-    ctx.out.set_rlg(r.ch.words(&r.cfg, counts, n));
+
+    #[local]
+    struct Local {
+        rig: &'static mut FogRig<f32>,
+        out: FramePath,
+        rlg_words: Consumer<'static, gyro_sp::rlg::RlgWords, { gyro_fw::app::RLG_QUEUE_LEN }>,
+        fog_thermal: FogThermal,
+        benches: ClosureBenches,
+        counter: u32,
+        total: u32,
+        rlg: Rlg,
+        frames: Consumer<'static, gyro_sp::frame::Frame, { gyro_fw::app::FRAME_QUEUE_LEN }>,
+        usart: stm32f4::stm32f405::USART1,
+        ipt: f32,
+    }
+
+    #[init(local = [
+        frame_queue: FrameQueue = FrameQueue::new(),
+        rlg_queue: RlgQueue = RlgQueue::new(),
+    ])]
+    fn init(cx: init::Context) -> (Shared, Local) {
+        stack::paint();
+        let mut syst = cx.core.SYST;
+        uart::init(&cx.device.USART1, 42);
+        let ipt = instructions_per_tick(&mut syst);
+
+        let params = fog_params(0);
+        let mut optics = OpticsParams::<f32>::nominal(params.tau_s as f32, SAMPLES_PER_HALF, 49_152);
+        optics.adc_bits = 12;
+        let params = optics.matched(params);
+        let Ok(cfg) = FogConfig::new(params) else {
+            fail()
+        };
+        let (profile, _) = qemu_demo::<f32>();
+        let total = (profile.total_duration() * CLOSURE_HZ as f32) as u32;
+        let (tx, frames) = cx.local.frame_queue.split();
+        let (words, rlg_words) = cx.local.rlg_queue.split();
+        let thermal = ThermalConfig::from_record(&RLG_RECORD, SENSOR_EVERY as f64 / RLG_HZ as f64);
+        if thermal.coeffs_default {
+            defmt::warn!("RLG coefficient record refused: running without thermal compensation");
+        }
+        let chamber_p = ChamberParams::default();
+        let rlg = Rlg {
+            cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ),
+            ch: RlgChannel::default(),
+            chamber: Chamber::new(chamber_p, 20.0),
+            profile: profile.clone(),
+            bus: SimI2c::new(),
+            sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
+            updates: 0,
+            bench: Bench::default(),
+            task: Bench::default(),
+            words,
+        };
+        // One coil sensor read per frame, 2 s of thermal time.
+        let sensor_dt_s = THERMAL_TIME_SCALE * CLOSURES_PER_FRAME as f64 / CLOSURE_HZ as f64;
+        let fog_thermal = FogThermal {
+            truth: ScaleFactorTruth::default(),
+            coil: CoilThermal::new(COIL_START_C),
+            sensor: Tmp117::new(COIL_SENSOR),
+            bus: SimI2c::new(),
+        };
+        let sf_cfg = ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, sensor_dt_s);
+        if sf_cfg.coeffs_refused {
+            defmt::warn!(
+                "FOG scale-factor record refused: running without temperature compensation"
+            );
+        }
+        // The rig (2.6 kB) is built in its static, not moved through the stack.
+        let Some(rig) = cortex_m::singleton!(: FogRig<f32> = FogRig::new(cfg, optics, profile))
+        else {
+            fail()
+        };
+        set_fog_truth(rig, &fog_thermal.truth, 0.5 / RLG_HZ as f64);
+        defmt::info!(
+            "gyro-fw qemu: FOG closure at {} Hz, {} steps, frames every {} steps",
+            CLOSURE_HZ,
+            total,
+            CLOSURES_PER_FRAME
+        );
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(RELOAD);
+        syst.clear_current();
+        syst.enable_interrupt();
+        syst.enable_counter();
+        (
+            Shared {
+                closure_benches: None,
+                rlg_bench: None,
+            },
+            Local {
+                rig,
+                out: FramePath::new(
+                    FrameBuilder::new(CLOSURES_PER_FRAME, cfg.n_half),
+                    tx,
+                    sf_cfg,
+                ),
+                rlg_words,
+                fog_thermal,
+                benches: ClosureBenches::default(),
+                counter: 0,
+                total,
+                rlg,
+                frames,
+                usart: cx.device.USART1,
+                ipt,
+            },
+        )
+    }
+
+    /// Sends the frames, pends the RLG update at a phase that sweeps the
+    /// closure period (golden-ratio sequence), and reports at the end.
+    #[idle(local = [frames, usart, ipt], shared = [closure_benches, rlg_bench])]
+    fn idle(mut cx: idle::Context) -> ! {
+        let mut sent = 0u32;
+        let mut phase = 0u32;
+        // SysTick count at the last poll while an RLG update is due.
+        let mut last = u32::MAX;
+        loop {
+            while let Some(f) = cx.local.frames.dequeue() {
+                uart::write(cx.local.usart, &f.encode());
+                sent += 1;
+            }
+            if RLG_DUE.load(Ordering::Acquire) {
+                // Ticks left before the next closure at which the RLG
+                // starts; a closure in between (the count went up) starts
+                // it at once, so it still delivers before the frame ends.
+                let target = ((phase as u64 * RELOAD as u64) >> 32) as u32 + 1;
+                let now = SYST::get_current();
+                if now <= target || now > last {
+                    phase = phase.wrapping_add(0x9E37_79B9);
+                    RLG_DUE.store(false, Ordering::Release);
+                    rtic::pend(stm32f4::stm32f405::Interrupt::TIM5);
+                    last = u32::MAX;
+                } else {
+                    last = now;
+                }
+                continue;
+            }
+            if DONE.load(Ordering::Acquire) && !cx.local.frames.ready() {
+                break;
+            }
+            SLEEPING.store(true, Ordering::Relaxed);
+            cortex_m::asm::wfi();
+            SLEEPING.store(false, Ordering::Relaxed);
+        }
+        let b = cx.shared.closure_benches.lock(|b| *b).unwrap_or_default();
+        let (rlg, rlg_task) = cx.shared.rlg_bench.lock(|b| *b).unwrap_or_default();
+        let ipt = *cx.local.ipt;
+        let (mean, max) = b.core.instructions(ipt);
+        defmt::info!("frames sent: {}", sent);
+        defmt::info!(
+            "bench: fog_closure_instructions={} max={} stack_bytes={}",
+            mean,
+            max,
+            stack::high_water()
+        );
+        let (rmean, rmax) = rlg.instructions(ipt);
+        let (tmean, tmax) = rlg_task.instructions(ipt);
+        defmt::info!(
+            "bench: rlg_update_instructions={} rlg_max={} rlg_task_with_chamber={} rlg_task_max={}",
+            rmean,
+            rmax,
+            tmean,
+            tmax
+        );
+        let (fmean, fmax) = b.sf_frame.instructions(ipt);
+        let (smean, smax) = b.sf_sensor.instructions(ipt);
+        defmt::info!(
+            "bench: fog_sf_frame_instructions={} sf_frame_max={} fog_sf_sensor_instructions={} sf_sensor_max={}",
+            fmean,
+            fmax,
+            smean,
+            smax
+        );
+        let (lmean, lmax) = b.latency_alone.instructions(ipt);
+        let (rl_mean, rl_max) = b.latency_under_rlg.instructions(ipt);
+        defmt::info!(
+            "bench: closure_latency_instructions={} closure_latency_max={} closure_latency_under_rlg={} closure_latency_under_rlg_max={} closures_under_rlg={}",
+            lmean,
+            lmax,
+            rl_mean,
+            rl_max,
+            b.latency_under_rlg.n
+        );
+        cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_SUCCESS);
+        loop {
+            cortex_m::asm::wfi();
+        }
+    }
+
+    /// The closure (highest priority): optics simulated, the FOG core run,
+    /// the frame assembled. Shares nothing the RLG update locks.
+    #[task(binds = SysTick, priority = 2,
+           local = [rig, out, rlg_words, fog_thermal, benches, counter, total],
+           shared = [closure_benches])]
+    fn closure(mut cx: closure::Context) {
+        // Ticks since the SysTick wrap raised this interrupt.
+        let entry = RELOAD.saturating_sub(SYST::get_current());
+        let rlg_busy = RLG_RUNNING.load(Ordering::Relaxed)
+            || cortex_m::peripheral::NVIC::is_pending(stm32f4::stm32f405::Interrupt::TIM5);
+        let woke = SLEEPING.load(Ordering::Relaxed);
+        let l = cx.local;
+        if *l.counter >= *l.total {
+            if !DONE.swap(true, Ordering::AcqRel) {
+                let b = *l.benches;
+                cx.shared.closure_benches.lock(|s| *s = Some(b));
+            }
+            return;
+        }
+        l.rig.optics.p.power = if POWER_LOSS.contains(l.counter) {
+            0.05
+        } else {
+            1.0
+        };
+        let truth = l.rig.simulate_optics();
+        let t0 = SYST::get_current();
+        let out = l.rig.process_core();
+        let t1 = SYST::get_current();
+        l.benches.core.record(t0, t1);
+        let latency = entry + ticks_between(t0, t1);
+        if woke {
+            // Not measured (see SLEEPING).
+        } else if rlg_busy {
+            l.benches.latency_under_rlg.add(latency);
+        } else {
+            l.benches.latency_alone.add(latency);
+        }
+        l.rig.finish_step(out, truth);
+        *l.counter += 1;
+        if out.faults.has(Faults::OPTICAL_POWER_LOW) && *l.counter == POWER_LOSS.start + 1 {
+            defmt::warn!("optical power low at step {}", *l.counter);
+        }
+        let to_frame_end = CLOSURES_PER_FRAME as u32 - *l.counter % CLOSURES_PER_FRAME as u32;
+        if to_frame_end == RLG_LEAD {
+            RLG_DUE.store(true, Ordering::Release);
+        } else if to_frame_end == RLG_LAST_START && RLG_DUE.swap(false, Ordering::AcqRel) {
+            // The idle loop has not started it: start it now, so it still
+            // delivers before the frame ends.
+            rtic::pend(stm32f4::stm32f405::Interrupt::TIM5);
+        }
+        if l.out.frame_ends() {
+            while let Some(w) = l.rlg_words.dequeue() {
+                l.out.set_rlg(w);
+            }
+            fog_thermal_update(l.rig, l.fog_thermal, l.out, &mut l.benches.sf_sensor, *l.counter);
+        }
+        if let Some(mut f) = l.out.push(&out) {
+            // The frame path's work: the scale-factor table at the coil
+            // temperature, applied to the frame's angle.
+            let t0 = SYST::get_current();
+            l.out.compensate(&mut f);
+            let t1 = SYST::get_current();
+            l.benches.sf_frame.record(t0, t1);
+            l.out.send(f);
+        }
+    }
+
+    /// One RLG update (lower priority, preempted by the closure): the
+    /// chamber advances one update period and the counter is read; on sensor
+    /// ticks the three TMP117s are read and the compensation runs (the bench
+    /// times counter read + compensation, the hw task's work). The frame
+    /// words go to the closure through a lock-free queue.
+    #[task(binds = TIM5, priority = 1, local = [rlg], shared = [rlg_bench])]
+    fn rlg_update(mut cx: rlg_update::Context) {
+        RLG_RUNNING.store(true, Ordering::Relaxed);
+        let start = SYST::get_current();
+        let r = &mut *cx.local.rlg;
+        let dt = 1.0 / RLG_HZ as f64;
+        let t_mid = (r.updates as f64 + 0.5) * dt;
+        let rate_dps = r.profile.rate_at(t_mid as f32) as f64 * (180.0 / core::f64::consts::PI);
+        let s = r.chamber.step(dt, 20.0, rate_dps);
+        r.bus.temps_c[..3].copy_from_slice(&[s.t_mono_a_c, s.t_mono_b_c, s.t_case_c]);
+        r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
+        let temps = r
+            .updates
+            .is_multiple_of(SENSOR_EVERY)
+            .then(|| Temperatures {
+                mono_a_q8: r.sensors[0].read(&mut r.bus),
+                mono_b_q8: r.sensors[1].read(&mut r.bus),
+                case_q8: r.sensors[2].read(&mut r.bus),
+            });
+        let t0 = SYST::get_current();
+        r.ch.update(&r.cfg, s.counter, temps.as_ref());
+        let t1 = SYST::get_current();
+        if temps.is_some() {
+            r.bench.record(t0, t1);
+        }
+        r.updates += 1;
+        let (counts, n) = r.ch.take_frame();
+        // Full only if the closure has stopped taking them; the counts then
+        // stay in the channel for the next update's words.
+        if r.words.enqueue(r.ch.words(&r.cfg, counts, n)).is_err() {
+            r.ch.restore_frame(counts, n);
+        }
+        r.task.record(start, SYST::get_current());
+        let b = (r.bench, r.task);
+        cx.shared.rlg_bench.lock(|s| *s = Some(b));
+        RLG_RUNNING.store(false, Ordering::Relaxed);
+    }
 }
 
 /// The rig's scale-factor error and bias for the frame centred on closure
@@ -390,19 +540,23 @@ fn set_fog_truth(rig: &mut FogRig<f32>, truth: &ScaleFactorTruth, t_mid: f64) {
 /// Once per frame: the coil sensor (lagging the coil) is read through the
 /// TMP117 driver and the table's state advances (what the bench times);
 /// the rig takes the truth for the next frame.
-fn fog_thermal_update(ctx: &mut Ctx) {
+fn fog_thermal_update(
+    rig: &mut FogRig<f32>,
+    th: &mut FogThermal,
+    out: &mut FramePath,
+    bench: &mut Bench,
+    counter: u32,
+) {
     let frame_s = CLOSURES_PER_FRAME as f64 / CLOSURE_HZ as f64;
-    let t = ctx.counter as f64 / CLOSURE_HZ as f64;
-    let th = &mut ctx.fog_thermal;
+    let t = counter as f64 / CLOSURE_HZ as f64;
     let sensor_c = th.coil.step_coil(frame_s * THERMAL_TIME_SCALE, coil_at(t));
-    let bus = &mut ctx.rlg.bus;
-    bus.temps_c[3] = sensor_c;
-    let read = th.sensor.read(bus);
+    th.bus.temps_c[3] = sensor_c;
+    let read = th.sensor.read(&mut th.bus);
     let t0 = SYST::get_current();
-    ctx.out.coil_reading(read);
+    out.coil_reading(read);
     let t1 = SYST::get_current();
-    ctx.sf_sensor_bench.record(t0, t1);
-    set_fog_truth(&mut ctx.rig, &ctx.fog_thermal.truth, t + 0.5 * frame_s);
+    bench.record(t0, t1);
+    set_fog_truth(rig, &th.truth, t + 0.5 * frame_s);
 }
 
 /// Instructions per SysTick tick, measured on a loop of known length

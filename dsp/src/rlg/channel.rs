@@ -94,6 +94,13 @@ impl RlgChannel {
         r
     }
 
+    /// Puts back counts `take_frame` gave whose words could not be delivered:
+    /// they go out with the next update's.
+    pub fn restore_frame(&mut self, counts: i64, updates: u32) {
+        self.frame_counts += counts;
+        self.frame_updates += updates;
+    }
+
     /// Builds the frame words from `take_frame`'s counts and updates.
     pub fn words(&self, cfg: &RlgConfig, counts: i64, updates: u32) -> RlgWords {
         // rate = counts * ndeg/count * update_hz / updates, in i128: counts

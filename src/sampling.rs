@@ -1,0 +1,142 @@
+//! The FOG's sampling on the hw board: ADC1 conversions into one ping-pong
+//! buffer by DMA2 stream 0, DAC words out of another through SPI1 by DMA2
+//! stream 5, each circular over two closures. The half/complete interrupt
+//! hands the closure the half just filled and the DAC half just sent
+//! (batch processing, as in quartiq's stabilizer).
+//!
+//! Named PAC fields, because the HAL has no word for these: the circular
+//! half/complete DMA ping-pong, the ADC's analog watchdog, the SPI's 16-bit
+//! TX DMA with the hardware NSS output, and the timers' DMA request and
+//! trigger output.
+
+use crate::app::{ADC_PER_CLOSURE, HALF_PERIODS};
+use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
+use stm32f4::stm32f405 as pac;
+
+/// ADC samples of two closures (the ping-pong), ADC LSB left-aligned.
+pub type AdcBuffer = [u16; 2 * ADC_PER_CLOSURE];
+/// DAC words of two closures, one per half period.
+pub type DacBuffer = [u16; 2 * HALF_PERIODS];
+
+/// The running sampling: what the closure interrupt needs each time.
+pub struct Sampling {
+    dma: pac::DMA2,
+    /// Only the analog watchdog's flag is touched here.
+    adc: pac::ADC1,
+    adc_buf: *const u16,
+    dac_buf: *mut u16,
+}
+
+// The buffers are 'static and only the closure task holds this.
+unsafe impl Send for Sampling {}
+
+/// One closure's share of the buffers.
+pub struct Half<'a> {
+    pub adc: &'a [u16],
+    pub dac: &'a mut [u16],
+    /// The ADC's analog watchdog fired since the last closure.
+    pub adc_over_range: bool,
+}
+
+impl Sampling {
+    /// Sets up both streams (not yet running the timers), the ADC's analog
+    /// watchdog, and the SPI's and timers' DMA links. `adc_dr`/`spi_dr`:
+    /// the data registers' addresses; the DAC buffer holds valid words.
+    pub fn new(
+        dma: pac::DMA2,
+        adc: pac::ADC1,
+        adc_dr: u32,
+        spi: &pac::spi1::RegisterBlock,
+        adc_buf: &'static mut AdcBuffer,
+        dac_buf: &'static mut DacBuffer,
+    ) -> Self {
+        // SPI1: 16-bit frames were set by the HAL; the NSS output frames
+        // each word for the DAC, TX DMA feeds it.
+        spi.cr2().modify(|_, w| w.ssoe().set_bit().txdmaen().set_bit());
+        // Hardware NSS (the HAL manages NSS in software).
+        spi.cr1().modify(|_, w| w.ssm().clear_bit());
+        // Analog watchdog on every regular conversion: codes outside the
+        // core's window [AWD_LOW, AWD_HIGH) flag the closure, so it does not
+        // search 64 samples for rails.
+        adc.ltr().write(|w| w.lt().set(AWD_LOW >> 4));
+        adc.htr().write(|w| w.ht().set((AWD_HIGH >> 4) - 1));
+        adc.cr1().modify(|_, w| w.awden().set_bit());
+        // Stream 5 channel 6 (TIM1_UP): memory -> SPI1 DR, circular, one
+        // word per half period.
+        let s5 = dma.st(5);
+        s5.par().write(|w| unsafe { w.pa().bits(spi.dr().as_ptr() as u32) });
+        s5.m0ar().write(|w| unsafe { w.m0a().bits(dac_buf.as_ptr() as u32) });
+        s5.ndtr().write(|w| w.ndt().set(dac_buf.len() as u16));
+        s5.cr().write(|w| {
+            w.chsel().set(6);
+            w.msize().bits16().psize().bits16();
+            w.minc().incremented().circ().enabled();
+            w.dir().memory_to_peripheral().en().enabled()
+        });
+        // Stream 0 channel 0: ADC1 DR -> buffer, circular, half and
+        // complete interrupts (one per closure).
+        let s0 = dma.st(0);
+        s0.par().write(|w| unsafe { w.pa().bits(adc_dr) });
+        s0.m0ar().write(|w| unsafe { w.m0a().bits(adc_buf.as_ptr() as u32) });
+        s0.ndtr().write(|w| w.ndt().set(adc_buf.len() as u16));
+        s0.cr().write(|w| {
+            w.chsel().set(0).pl().high();
+            w.msize().bits16().psize().bits16();
+            w.minc().incremented().circ().enabled();
+            w.htie().enabled().tcie().enabled();
+            w.dir().peripheral_to_memory().en().enabled()
+        });
+        Self {
+            dma,
+            adc,
+            adc_buf: adc_buf.as_ptr(),
+            dac_buf: dac_buf.as_mut_ptr(),
+        }
+    }
+
+    /// In the stream 0 interrupt: clears its flags and returns the halves
+    /// of the closure just sampled (half transfer: the first, transfer
+    /// complete: the second).
+    #[inline(always)]
+    pub fn take_half(&mut self) -> Half<'_> {
+        let second = self.dma.lisr().read().tcif0().is_complete();
+        self.dma.lifcr().write(|w| {
+            w.ctcif0().clear().chtif0().clear().cteif0().clear();
+            w.cdmeif0().clear().cfeif0().clear()
+        });
+        // The watchdog flag is sticky: read and cleared once per closure (a
+        // conversion of the closure now sampling may count with this one;
+        // that errs safe).
+        let adc_over_range = self.adc.sr().read().awd().is_event();
+        self.adc.sr().write(|w| w.awd().clear());
+        let (a, d) = if second {
+            (ADC_PER_CLOSURE, HALF_PERIODS)
+        } else {
+            (0, 0)
+        };
+        // SAFETY: both buffers are 'static and the DMA is writing the other
+        // half of the ADC buffer and reading the other half of the DAC
+        // buffer for the whole closure period.
+        unsafe {
+            Half {
+                adc: core::slice::from_raw_parts(self.adc_buf.add(a), ADC_PER_CLOSURE),
+                dac: core::slice::from_raw_parts_mut(self.dac_buf.add(d), HALF_PERIODS),
+                adc_over_range,
+            }
+        }
+    }
+}
+
+/// TIM1 requests one DAC word per update (UDE); TIM2's update is the ADC's
+/// trigger output (TRGO). Set before the HAL starts the timers.
+pub fn link_timers(tim1: &pac::tim1::RegisterBlock, tim2: &pac::tim2::RegisterBlock) {
+    tim1.dier().modify(|_, w| w.ude().set_bit());
+    tim2.cr2().modify(|_, w| w.mms().update());
+}
+
+/// TIM4 encoder inputs: digital filter of 8 samples at fCK_INT on both
+/// channels (the HAL's encoder mode sets none).
+pub fn encoder_filter(tim4: &pac::tim3::RegisterBlock) {
+    tim4.ccmr1_input()
+        .modify(|_, w| w.ic1f().set(0b0011).ic2f().set(0b0011));
+}
