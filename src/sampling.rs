@@ -52,7 +52,8 @@ impl Sampling {
     ) -> Self {
         // SPI1: 16-bit frames were set by the HAL; the NSS output frames
         // each word for the DAC, TX DMA feeds it.
-        spi.cr2().modify(|_, w| w.ssoe().set_bit().txdmaen().set_bit());
+        spi.cr2()
+            .modify(|_, w| w.ssoe().set_bit().txdmaen().set_bit());
         // Hardware NSS (the HAL manages NSS in software).
         spi.cr1().modify(|_, w| w.ssm().clear_bit());
         // Analog watchdog on every regular conversion: codes outside the
@@ -64,8 +65,10 @@ impl Sampling {
         // Stream 5 channel 6 (TIM1_UP): memory -> SPI1 DR, circular, one
         // word per half period.
         let s5 = dma.st(5);
-        s5.par().write(|w| unsafe { w.pa().bits(spi.dr().as_ptr() as u32) });
-        s5.m0ar().write(|w| unsafe { w.m0a().bits(dac_buf.as_ptr() as u32) });
+        s5.par()
+            .write(|w| unsafe { w.pa().bits(spi.dr().as_ptr() as u32) });
+        s5.m0ar()
+            .write(|w| unsafe { w.m0a().bits(dac_buf.as_ptr() as u32) });
         s5.ndtr().write(|w| w.ndt().set(dac_buf.len() as u16));
         s5.cr().write(|w| {
             w.chsel().set(6);
@@ -77,7 +80,8 @@ impl Sampling {
         // complete interrupts (one per closure).
         let s0 = dma.st(0);
         s0.par().write(|w| unsafe { w.pa().bits(adc_dr) });
-        s0.m0ar().write(|w| unsafe { w.m0a().bits(adc_buf.as_ptr() as u32) });
+        s0.m0ar()
+            .write(|w| unsafe { w.m0a().bits(adc_buf.as_ptr() as u32) });
         s0.ndtr().write(|w| w.ndt().set(adc_buf.len() as u16));
         s0.cr().write(|w| {
             w.chsel().set(0).pl().high();

@@ -9,7 +9,7 @@
 //! | 6 | u16 | fault flags, OR over the frame's steps ([`crate::fog::Faults`]) |
 //! | 8 | u16 | closure steps in this frame |
 //! | 10 | u32 | closure-step counter at the end of the frame (wraps) |
-//! | 14 | i64 | FOG angle increment, corrected: sum of `step_corrected` over every half period (angle LSB = 2*pi/2^32 rad * tau / K_s) |
+//! | 14 | i64 | FOG angle increment, corrected: sum of `sagnac_phase_corrected` over every half period (angle LSB = 2*pi/2^32 rad * tau / K_s) |
 //! | 22 | i64 | FOG angle increment without the epsilon-squared correction |
 //! | 30 | i32 | FOG residual of the last step, phase LSB |
 //! | 34 | u32 | 2*pi loop gain, DAC codes per turn, Q8 |
@@ -45,8 +45,8 @@ const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 pub struct Frame {
     pub seq: u16,
     pub faults: u16,
-    pub steps: u16,
-    pub step_counter: u32,
+    pub closures: u16,
+    pub closure_counter: u32,
     pub fog_angle: i64,
     pub fog_angle_raw: i64,
     pub fog_residual: i32,
@@ -76,8 +76,8 @@ impl Frame {
         w.put(&[VERSION, (FRAME_LEN - 4) as u8]);
         w.put(&self.seq.to_le_bytes());
         w.put(&self.faults.to_le_bytes());
-        w.put(&self.steps.to_le_bytes());
-        w.put(&self.step_counter.to_le_bytes());
+        w.put(&self.closures.to_le_bytes());
+        w.put(&self.closure_counter.to_le_bytes());
         w.put(&self.fog_angle.to_le_bytes());
         w.put(&self.fog_angle_raw.to_le_bytes());
         w.put(&self.fog_residual.to_le_bytes());
@@ -127,8 +127,8 @@ impl Frame {
         Ok(Self {
             seq: u16::from_le_bytes(r.take()),
             faults: u16::from_le_bytes(r.take()),
-            steps: u16::from_le_bytes(r.take()),
-            step_counter: u32::from_le_bytes(r.take()),
+            closures: u16::from_le_bytes(r.take()),
+            closure_counter: u32::from_le_bytes(r.take()),
             fog_angle: i64::from_le_bytes(r.take()),
             fog_angle_raw: i64::from_le_bytes(r.take()),
             fog_residual: i32::from_le_bytes(r.take()),
@@ -161,7 +161,7 @@ impl Frame {
     /// corrected angle (at frame completion, so a frame merged back after a
     /// full queue is compensated whole).
     pub fn compensate_fog(&mut self, sf: &ScaleFactorComp, cfg: &ScaleFactorConfig) {
-        let (angle, words) = sf.compensate(cfg, self.fog_angle, self.steps);
+        let (angle, words) = sf.compensate(cfg, self.fog_angle, self.closures);
         self.fog_angle_comp = angle;
         self.fog_temp = words;
     }
@@ -199,37 +199,37 @@ impl Reader<'_> {
 #[derive(Clone, Copy, Debug)]
 pub struct FrameBuilder {
     acc: Frame,
-    steps_per_frame: u16,
+    closures_per_frame: u16,
     n_half: i64,
     next_seq: u16,
 }
 
 impl FrameBuilder {
-    pub fn new(steps_per_frame: u16, n_half: usize) -> Self {
+    pub fn new(closures_per_frame: u16, n_half: usize) -> Self {
         Self {
             acc: Frame::default(),
-            steps_per_frame: steps_per_frame.max(1),
+            closures_per_frame: closures_per_frame.max(1),
             n_half: n_half as i64,
             next_seq: 0,
         }
     }
 
-    /// Adds one closure step; returns a complete frame every `steps_per_frame` steps.
-    pub fn push(&mut self, out: &crate::fog::ClosureOutput, step_counter: u32) -> Option<Frame> {
+    /// Adds one closure step; returns a complete frame every `closures_per_frame` steps.
+    pub fn push(&mut self, out: &crate::fog::ClosureOutput, closure_counter: u32) -> Option<Frame> {
         let a = &mut self.acc;
-        a.steps = a.steps.saturating_add(1);
+        a.closures = a.closures.saturating_add(1);
         a.faults |= out.faults.0;
-        a.step_counter = step_counter;
+        a.closure_counter = closure_counter;
         a.fog_angle = a
             .fog_angle
-            .wrapping_add(out.step_corrected.wrapping_mul(self.n_half));
+            .wrapping_add(out.sagnac_phase_corrected.wrapping_mul(self.n_half));
         a.fog_angle_raw = a
             .fog_angle_raw
-            .wrapping_add(out.step.wrapping_mul(self.n_half));
+            .wrapping_add(out.sagnac_phase.wrapping_mul(self.n_half));
         a.fog_residual = out.residual;
         a.codes_per_turn_q8 = out.codes_per_turn_q8;
         a.dc = out.dc;
-        if a.steps >= self.steps_per_frame {
+        if a.closures >= self.closures_per_frame {
             let mut f = core::mem::take(a);
             f.seq = self.next_seq;
             self.next_seq = self.next_seq.wrapping_add(1);
@@ -241,7 +241,7 @@ impl FrameBuilder {
 
     /// True when the next closure pushed completes a frame.
     pub fn completes_next(&self) -> bool {
-        self.acc.steps.saturating_add(1) >= self.steps_per_frame
+        self.acc.closures.saturating_add(1) >= self.closures_per_frame
     }
 
     /// Puts the RLG words of this frame in (counts add up, the rest is latest).
@@ -257,7 +257,7 @@ impl FrameBuilder {
     /// frame (flagged), which reuses its sequence number, so no angle is lost.
     pub fn restore(&mut self, f: Frame) {
         let a = &mut self.acc;
-        a.steps = a.steps.saturating_add(f.steps);
+        a.closures = a.closures.saturating_add(f.closures);
         a.faults |= f.faults | crate::fog::Faults::QUEUE_FULL;
         a.fog_angle = a.fog_angle.wrapping_add(f.fog_angle);
         a.fog_angle_raw = a.fog_angle_raw.wrapping_add(f.fog_angle_raw);

@@ -33,15 +33,15 @@ pub struct Means {
 }
 
 pub fn mean_error(rig: &mut FogRig<f64>, from: u64, to: u64) -> Means {
-    let lsb = rig.cfg.rad_s_per_step_lsb();
+    let lsb = rig.cfg.rad_s_per_phase_lsb();
     let (mut c, mut r, mut n, mut faults) = (0.0, 0.0, 0.0, 0u16);
     let mut last = ClosureOutput::default();
-    while rig.step_index() < to {
-        let k = rig.step_index();
-        let s = rig.step();
+    while rig.closure_index() < to {
+        let k = rig.closure_index();
+        let s = rig.run_closure();
         if k >= from {
-            c += s.out.step_corrected as f64 * lsb - s.true_rate;
-            r += s.out.step as f64 * lsb - s.true_rate;
+            c += s.out.sagnac_phase_corrected as f64 * lsb - s.true_rate;
+            r += s.out.sagnac_phase as f64 * lsb - s.true_rate;
             n += 1.0;
             faults |= s.out.faults.0;
         }
@@ -79,19 +79,19 @@ pub fn vibration_drift(
     (min_s, max_s): (f64, f64),
 ) -> Drift {
     let dt = rig.cfg.closure_period_s();
-    let lsb = rig.cfg.rad_s_per_step_lsb();
+    let lsb = rig.cfg.rad_s_per_phase_lsb();
     let periods = freq.ceil();
     let block = (periods / freq / dt).round() as u64;
-    while rig.step_index() < settle {
-        rig.step();
+    while rig.closure_index() < settle {
+        rig.run_closure();
     }
     let (mut raw, mut corr) = (Vec::new(), 0.0);
     loop {
         let (mut b, mut c) = (0.0, 0.0);
         for _ in 0..block {
-            let s = rig.step();
-            b += s.out.step as f64 * lsb - s.true_rate;
-            c += s.out.step_corrected as f64 * lsb - s.true_rate;
+            let s = rig.run_closure();
+            b += s.out.sagnac_phase as f64 * lsb - s.true_rate;
+            c += s.out.sagnac_phase_corrected as f64 * lsb - s.true_rate;
         }
         raw.push(b / block as f64 * DPH);
         corr += c / block as f64 * DPH;

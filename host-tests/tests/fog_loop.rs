@@ -1,7 +1,7 @@
 //! Closed loop on the simulated photodetector: lock, linearity, steps, 2*pi loop, faults.
 //! Lock, steps and the 2*pi loop are checked for both DAC pipelines: words
 //! applied the next step (QEMU, host) and the step after next (the hw DMA
-//! ping-pong, `dac_latency_steps = 1`).
+//! ping-pong, `dac_latency = 1`).
 
 use gyro_sim::{Profile, Segment};
 use gyro_sp::fog::{Faults, FogParams};
@@ -10,7 +10,7 @@ use host_tests::*;
 /// The default instrument with `latency` steps of DAC latency.
 fn with_latency(latency: u32) -> FogParams {
     FogParams {
-        dac_latency_steps: latency,
+        dac_latency: latency,
         ..FogParams::default()
     }
 }
@@ -137,13 +137,13 @@ fn rate_step(latency: u32) {
         },
     ]);
     let mut r = rig(with_latency(latency), |_| {}, p);
-    let lsb = r.cfg.rad_s_per_step_lsb();
+    let lsb = r.cfg.rad_s_per_phase_lsb();
     let step_at = (0.01 * 12_500.0) as u64;
     let mut errs = Vec::new();
-    while r.step_index() < step_at + 20 {
-        let s = r.step();
-        if r.step_index() > step_at {
-            errs.push((s.out.step as f64 * lsb - s.true_rate) / (80.0 * DEG));
+    while r.closure_index() < step_at + 20 {
+        let s = r.run_closure();
+        if r.closure_index() > step_at {
+            errs.push((s.out.sagnac_phase as f64 * lsb - s.true_rate) / (80.0 * DEG));
         }
     }
     // From the seventh step (560 us) on the error is below 1e-3 of the step
@@ -211,14 +211,14 @@ fn power_loss_flags_then_recovers() {
 fn adc_saturation_flags_and_holds() {
     let mut r = rig(FogParams::default(), |_| {}, Profile::constant(10.0 * DEG));
     mean_error(&mut r, 0, 500);
-    let before = r.fog.step();
+    let before = r.fog.feedback();
     r.optics.p.power = 20.0; // detector overdriven past the ADC top
     let sat = mean_error(&mut r, 500, 520);
     assert!(sat.last.faults.has(Faults::ADC_SATURATION));
     // Every sample clipped: the error sums to zero, so the loop (which keeps
     // running through over-range) leaves the step where it was.
     assert_eq!(
-        r.fog.step(),
+        r.fog.feedback(),
         before,
         "a fully clipped step must not move the loop"
     );

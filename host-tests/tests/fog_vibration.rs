@@ -102,7 +102,7 @@ fn correction_works_at_20_and_200_hz() {
 }
 
 /// The hw board's DMA ping-pong applies the words one step later
-/// (`dac_latency_steps = 1`). The loop then lags a rate ramp by 1/g + 1 steps
+/// (`dac_latency = 1`). The loop then lags a rate ramp by 1/g + 1 steps
 /// instead of 1/g, so the drift doubles at unit gain
 /// (`FogConfig::predicted_vibration_drift`); the correction, which inverts
 /// each step's own measurement, needs no change. Both instruments, 60 Hz and
@@ -120,7 +120,7 @@ fn dac_latency_doubles_the_drift_and_the_correction_removes_it() {
         let top = if phi0 > 0.8 * PI { 20_000.0 } else { 50_000.0 };
         for (freq, eps) in [(60.0, 5_000.0), (60.0, top), (200.0, top)] {
             let params = FogParams {
-                dac_latency_steps: 1,
+                dac_latency: 1,
                 ..instrument(phi0, closure)
             };
             check(params, eps, freq, freq < 100.0, &mut failures);
@@ -146,11 +146,11 @@ fn loop_gain_holds_under_vibration_near_dark_fringe() {
     let (a, b) = whole_periods(&r.cfg, 60.0, SETTLE, 1.0);
     let (ks, lsb) = (r.cfg.k_sagnac_s, gyro_sp::RAD_PER_PHASE_LSB);
     let (mut md, mut dd) = (0.0, 0.0);
-    while r.step_index() < b {
-        let k = r.step_index();
-        let s = r.step();
+    while r.closure_index() < b {
+        let k = r.closure_index();
+        let s = r.run_closure();
         if k >= a {
-            let applied = (s.out.step - s.out.residual as i64) as f64 * lsb;
+            let applied = (s.out.sagnac_phase - s.out.residual as i64) as f64 * lsb;
             let truth = ks * s.true_rate - applied;
             md += s.out.residual as f64 * lsb * truth;
             dd += truth * truth;

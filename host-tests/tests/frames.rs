@@ -11,7 +11,7 @@ use proptest::prelude::*;
 fn out(step: i64) -> ClosureOutput {
     ClosureOutput {
         step,
-        step_corrected: step - 3,
+        sagnac_phase_corrected: step - 3,
         ..ClosureOutput::default()
     }
 }
@@ -21,8 +21,8 @@ fn round_trip_and_crc() {
     let f = Frame {
         seq: 7,
         faults: 5,
-        steps: 25,
-        step_counter: 1234,
+        closures: 25,
+        closure_counter: 1234,
         fog_angle: -99,
         fog_angle_raw: 1 << 40,
         fog_residual: -5,
@@ -90,7 +90,7 @@ fn restored_frame_loses_no_angle() {
         }
     }
     let sent: i64 = emitted.iter().map(|f| f.fog_angle).sum();
-    let pending = 40 - emitted.iter().map(|f| f.steps as i64).sum::<i64>();
+    let pending = 40 - emitted.iter().map(|f| f.closures as i64).sum::<i64>();
     let pending_angle: i64 = (40 - pending..40).map(|k| (k - 3) * 16).sum();
     assert_eq!(sent + pending_angle, total);
     // The compensated angle of a frame merged back is compensated whole

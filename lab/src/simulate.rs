@@ -276,7 +276,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
     let (mut b_err, mut b_raw, mut b_n) = (0.0f64, 0.0f64, 0u64);
 
     let mut rig = FogRig::new(cfg, optics, profile);
-    let lsb_rate = cfg.rad_s_per_step_lsb();
+    let lsb_rate = cfg.rad_s_per_phase_lsb();
     let bar = if steps > 200_000 && !a.json {
         let b = ProgressBar::new(steps);
         b.set_style(
@@ -308,9 +308,9 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
     let mut acc_n = 0u32;
     let t0 = std::time::Instant::now();
     for k in 0..steps {
-        let r = rig.step();
-        let out = r.out.step_corrected as f64 * lsb_rate;
-        let raw = r.out.step as f64 * lsb_rate;
+        let r = rig.run_closure();
+        let out = r.out.sagnac_phase_corrected as f64 * lsb_rate;
+        let raw = r.out.sagnac_phase as f64 * lsb_rate;
         if k >= start_avg {
             err_sum += out - r.true_rate;
             raw_sum += raw - r.true_rate;

@@ -18,7 +18,7 @@ pub struct FogRig<F> {
     pub scale_error: F,
     pub bias_rad_s: F,
     k_sagnac: F,
-    step_index: u64,
+    closure_index: u64,
     /// DAC buffers: [0] is applied this step and receives the closure's new
     /// words. With one step of DAC latency the two swap after each step (the
     /// hw DMA ping-pong: words written now are applied the step after next).
@@ -31,7 +31,7 @@ pub struct FogRig<F> {
 
 /// One step of the rig: the core's output and the truth.
 #[derive(Clone, Copy, Debug)]
-pub struct RigStep<F> {
+pub struct RigClosure<F> {
     pub out: ClosureOutput,
     /// Mean true rate over the step (of the per-half-period rates), rad/s.
     pub true_rate: F,
@@ -56,7 +56,7 @@ where
             profile,
             scale_error: F::zero(),
             bias_rad_s: F::zero(),
-            step_index: 0,
+            closure_index: 0,
             dac,
             adc: [0; MAX_HALF * MAX_SAMPLES_PER_HALF],
             sagnac: [F::zero(); MAX_HALF],
@@ -64,12 +64,12 @@ where
         }
     }
 
-    pub fn step_index(&self) -> u64 {
-        self.step_index
+    pub fn closure_index(&self) -> u64 {
+        self.closure_index
     }
 
     /// Runs one closure step.
-    pub fn step(&mut self) -> RigStep<F> {
+    pub fn run_closure(&mut self) -> RigClosure<F> {
         let true_rate = self.simulate_optics();
         let out = self.process_core();
         self.finish_step(out, true_rate)
@@ -81,7 +81,7 @@ where
         let n = self.cfg.n_half;
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
         let half = F::from(0.5).unwrap_or(F::zero());
-        let first = self.step_index * n as u64;
+        let first = self.closure_index * n as u64;
         let gain = self.k_sagnac * (F::one() + self.scale_error);
         let offset = self.k_sagnac * self.bias_rad_s;
         let mut sum = F::zero();
@@ -111,14 +111,14 @@ where
     }
 
     /// Completes a step run as `simulate_optics` + `process_core`.
-    pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigStep<F> {
-        self.step_index += 1;
-        if self.cfg.params.dac_latency_steps != 0 {
+    pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigClosure<F> {
+        self.closure_index += 1;
+        if self.cfg.params.dac_latency != 0 {
             self.dac.swap(0, 1);
         }
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
-        let t_end = F::from(self.step_index * self.cfg.n_half as u64).unwrap_or(F::zero()) * tau;
-        RigStep {
+        let t_end = F::from(self.closure_index * self.cfg.n_half as u64).unwrap_or(F::zero()) * tau;
+        RigClosure {
             out,
             true_rate,
             t_end,

@@ -32,8 +32,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use defmt_rtt as _;
 use gyro_fw::app::{
     fog_params, FramePath, FrameQueue, RlgQueue, ADC_PER_CLOSURE, CLOSURES_PER_FRAME, CLOSURE_HZ,
-    FOG_SF_RECORD, FRAME_QUEUE_LEN, HALF_PERIODS, RLG_HZ, RLG_QUEUE_LEN, RLG_RECORD,
-    SENSOR_EVERY,
+    FOG_SF_RECORD, FRAME_QUEUE_LEN, HALF_PERIODS, RLG_HZ, RLG_QUEUE_LEN, RLG_RECORD, SENSOR_EVERY,
 };
 use gyro_fw::sampling::{self, AdcBuffer, DacBuffer, Sampling};
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
@@ -44,7 +43,9 @@ use gyro_sp::rlg::{RlgChannel, RlgConfig, RlgWords};
 use heapless::spsc::{Consumer, Producer, Queue};
 use stm32f4xx_hal::{
     adc::{
-        config::{AdcConfig, Align, Clock, Dma, ExternalTrigger, SampleTime, Sequence, TriggerMode},
+        config::{
+            AdcConfig, Align, Clock, Dma, ExternalTrigger, SampleTime, Sequence, TriggerMode,
+        },
         Adc,
     },
     gpio::Speed,
@@ -361,7 +362,9 @@ mod app {
     fn closure(cx: closure::Context) {
         let c = cx.local.closure;
         let half = c.sampling.take_half();
-        let out = c.fog.process(&c.cfg, half.adc, half.adc_over_range, half.dac);
+        let out = c
+            .fog
+            .process(&c.cfg, half.adc, half.adc_over_range, half.dac);
         if c.out.frame_ends() {
             // The RLG words since the last frame.
             while let Some(w) = c.rlg_words.dequeue() {

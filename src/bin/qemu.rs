@@ -246,7 +246,8 @@ mod app {
         let ipt = instructions_per_tick(&mut syst);
 
         let params = fog_params(0);
-        let mut optics = OpticsParams::<f32>::nominal(params.tau_s as f32, SAMPLES_PER_HALF, 49_152);
+        let mut optics =
+            OpticsParams::<f32>::nominal(params.tau_s as f32, SAMPLES_PER_HALF, 49_152);
         optics.adc_bits = 12;
         let params = optics.matched(params);
         let Ok(cfg) = FogConfig::new(params) else {
@@ -464,7 +465,13 @@ mod app {
             while let Some(w) = l.rlg_words.dequeue() {
                 l.out.set_rlg(w);
             }
-            fog_thermal_update(l.rig, l.fog_thermal, l.out, &mut l.benches.sf_sensor, *l.counter);
+            fog_thermal_update(
+                l.rig,
+                l.fog_thermal,
+                l.out,
+                &mut l.benches.sf_sensor,
+                *l.counter,
+            );
         }
         if let Some(mut f) = l.out.push(&out) {
             // The frame path's work: the scale-factor table at the coil

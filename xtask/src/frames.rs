@@ -71,21 +71,21 @@ pub fn analyse(path: &Path) -> Result<Report> {
                     if f.seq != p.seq.wrapping_add(1) {
                         seq_gaps += 1;
                     }
-                    if f.step_counter.wrapping_sub(p.step_counter) != f.steps as u32 {
+                    if f.closure_counter.wrapping_sub(p.closure_counter) != f.closures as u32 {
                         step_gaps += 1;
                     }
                 }
                 last = Some(f);
-                let end = f.step_counter as u64;
-                let start = end - f.steps as u64;
+                let end = f.closure_counter as u64;
+                let start = end - f.closures as u64;
                 let mut truth = 0.0;
                 for k in start..end {
                     for j in 0..n_half {
                         truth += profile.rate_at(((k * n_half + j) as f64 + 0.5) * tau);
                     }
                 }
-                let halves = (f.steps as u64 * n_half) as f64;
-                let lsb = cfg.rad_s_per_step_lsb();
+                let halves = (f.closures as u64 * n_half) as f64;
+                let lsb = cfg.rad_s_per_phase_lsb();
                 let t_mid = (start + end) as f64 / 2.0 * n_half as f64 * tau;
                 let segment = seg_starts.iter().rposition(|&s| t_mid >= s).unwrap_or(0);
                 let frame_s = halves * tau;

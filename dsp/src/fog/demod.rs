@@ -10,7 +10,7 @@
 //! conversion outside [`AWD_LOW`, `AWD_HIGH`] in hardware (STM32 ADC_SR.AWD;
 //! the simulator models the same window), and the caller passes that flag in.
 
-use super::modulator::Carries;
+use super::modulator::Resets;
 
 /// Analog-watchdog window on the left-aligned 16-bit code (12-bit ADC: 0x10 is
 /// one code above zero, 0xFFE0 two codes below full scale).
@@ -19,7 +19,7 @@ pub const AWD_HIGH: u16 = 0xFFE0;
 
 /// Sums of one step; units are ADC LSB summed over the kept samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct DemodSums {
+pub(crate) struct DemodSums {
     /// sum(sign_j * h_j) over the first half of the step.
     pub first: i32,
     /// sum(sign_j * h_j) over the second half of the step.
@@ -32,34 +32,32 @@ pub struct DemodSums {
     pub carried: i32,
 }
 
-/// Demodulates `adc` (`n_half` half periods of `samples_per_half` samples);
-/// `carries` as [`Carries`]. `n_half` must be a multiple of 4 and at most 64
-/// (config checks it). The reference instruments' layouts (4 samples, 1
-/// skipped, 16 or 32 half periods) run a loop unrolled at compile time; any
-/// other layout gives the same sums through the runtime loop.
+/// Demodulates `adc` (`n_half` half periods of `samples_per_half` samples,
+/// `skip` skipped after each edge); `resets` as [`Resets`]. `n_half` must
+/// be a multiple of 4 and at most 64 (config checks it). With `H` non-zero
+/// the layout is `H` half periods of `S` samples, `SKIP` skipped, known at
+/// compile time (the closure's kernel chooses): the loop unrolls.
 #[inline(always)]
-pub fn demodulate(
+pub(crate) fn demodulate<const H: usize, const S: usize, const SKIP: usize>(
     adc: &[u16],
     samples_per_half: usize,
     skip: usize,
     n_half: usize,
-    carries: &Carries,
+    resets: &Resets,
 ) -> DemodSums {
     // Align the masks so pair 0's bit is bit 31.
     let shift = 32u32.saturating_sub((n_half / 2) as u32);
     let masks = (
-        carries.plus.checked_shl(shift).unwrap_or(0),
-        carries.minus.checked_shl(shift).unwrap_or(0),
+        resets.plus.checked_shl(shift).unwrap_or(0),
+        resets.minus.checked_shl(shift).unwrap_or(0),
     );
-    let fast = match (samples_per_half, skip, n_half) {
-        (4, 1, 16) => fixed::<4, 1, 64>(adc, masks),
-        (4, 1, 32) => fixed::<4, 1, 128>(adc, masks),
-        _ => None,
-    };
-    fast.unwrap_or_else(|| {
-        let adc = adc.get(..n_half * samples_per_half).unwrap_or(adc);
-        any(adc, samples_per_half, skip, n_half, masks)
-    })
+    if H != 0 {
+        if let Some(d) = fixed::<H, S, SKIP>(adc, masks) {
+            return d;
+        }
+    }
+    let adc = adc.get(..n_half * samples_per_half).unwrap_or(adc);
+    any(adc, samples_per_half, skip, n_half, masks)
 }
 
 /// Sum of the kept samples of one half period.
@@ -91,19 +89,19 @@ fn half_step<const N: usize, const S: usize>(
     (p, m)
 }
 
-/// `T` = `N` samples x half periods, a compile-time length so the loops unroll;
-/// `None` if `adc` is shorter (the caller falls back to [`any`]).
-/// Plus and minus halves are summed apart and combined once at the end.
+/// `H` half periods of `N` samples, `S` skipped: compile-time sizes so the
+/// loops unroll; `None` if `adc` is shorter (the caller falls back to
+/// [`any`]). Plus and minus halves are summed apart and combined once at the end.
 #[inline(always)]
-fn fixed<const N: usize, const S: usize, const T: usize>(
+fn fixed<const H: usize, const N: usize, const S: usize>(
     adc: &[u16],
     masks: (u32, u32),
 ) -> Option<DemodSums> {
-    let adc: &[u16; T] = adc.first_chunk::<T>()?;
-    let (a_first, a_second) = adc.split_at(T / 2);
+    let adc = adc.get(..H * N)?;
+    let (a_first, a_second) = adc.split_at(H * N / 2);
     let mut d = DemodSums::default();
     let (p1, m1) = half_step::<N, S>(a_first, &mut d, masks, 0);
-    let (p2, m2) = half_step::<N, S>(a_second, &mut d, masks, T / (4 * N));
+    let (p2, m2) = half_step::<N, S>(a_second, &mut d, masks, H / 4);
     d.first = p1 as i32 - m1 as i32;
     d.second = p2 as i32 - m2 as i32;
     d.dc = p1 + m1 + p2 + m2;
@@ -141,4 +139,60 @@ fn any(
         }
     }
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{demodulate, DemodSums, Resets};
+    use proptest::prelude::*;
+    use std::vec;
+
+    /// Straightforward demodulation, half period by half period.
+    fn reference(adc: &[u16], n: usize, skip: usize, halves: usize, c: &Resets) -> DemodSums {
+        let mut d = DemodSums::default();
+        for (j, half) in adc.chunks(n).take(halves).enumerate() {
+            let h: u32 = half[skip..].iter().map(|&x| x as u32).sum();
+            let s = if j % 2 == 0 { h as i32 } else { -(h as i32) };
+            if j < halves / 2 {
+                d.first += s
+            } else {
+                d.second += s
+            }
+            d.dc += h;
+            let pair_bit = halves / 2 - 1 - j / 2;
+            if j % 2 == 0 && c.plus >> pair_bit & 1 == 1 {
+                d.carried += h as i32;
+            }
+            if j % 2 == 1 && c.minus >> pair_bit & 1 == 1 {
+                d.carried -= h as i32;
+            }
+        }
+        d
+    }
+
+    proptest! {
+        /// Every sample layout (the unrolled ones and the runtime fallback) gives
+        /// the reference sums.
+        #[test]
+        fn demodulation_matches_reference(
+            adc in proptest::collection::vec(any::<u16>(), 32 * 8),
+            plus in any::<u32>(),
+            minus in any::<u32>(),
+            layout in prop::sample::select(vec![(4usize, 1usize), (4, 2), (2, 1), (8, 2), (4, 0), (8, 3), (3, 1)]),
+            halves in prop::sample::select(vec![4usize, 16, 32]),
+        ) {
+            let (n, skip) = layout;
+            let a = &adc[..halves * n];
+            let keep = u32::MAX >> (32 - halves / 2);
+            let c = Resets { plus: plus & keep, minus: minus & keep, ..Resets::default() };
+            let want = reference(a, n, skip, halves, &c);
+            prop_assert_eq!(demodulate::<0, 0, 0>(a, n, skip, halves, &c), want);
+            // The unrolled copies, where the layout is theirs.
+            match (halves, n, skip) {
+                (16, 4, 1) => prop_assert_eq!(demodulate::<16, 4, 1>(a, n, skip, halves, &c), want),
+                (32, 4, 1) => prop_assert_eq!(demodulate::<32, 4, 1>(a, n, skip, halves, &c), want),
+                _ => {}
+            }
+        }
+    }
 }

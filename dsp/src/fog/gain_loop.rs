@@ -6,8 +6,49 @@
 //! `sum_j w_j*sign_j*(h_j - H)` over the reset half periods is proportional to +g;
 //! integrating it against the digital gain (codes per turn) keeps a reset exactly 2*pi.
 
+use super::config::FogParams;
+use crate::{phase_from_rad, Phase};
+use core::f64::consts::TAU;
+#[allow(unused_imports)] // f64 maths comes from libm where core lacks it
+use num_traits::float::Float;
+
+/// The 2*pi loop's gain, the digital gain's range and when it holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GainLoopConfig {
+    /// DAC Q8 codes-per-turn per unit normalised reset error (sum c_j*h_j /
+    /// H), divided by n_half (the estimate comes n times larger), Q4; below
+    /// 2^27.
+    pub gain: i32,
+    /// Nominal DAC codes per turn, and the clamp of the digital gain
+    /// (-20 %, +25 %), Q8.
+    pub nominal_q8: u32,
+    pub min_q8: u32,
+    pub max_q8: u32,
+    /// Residual beyond which the loop holds (0.1 rad), phase LSB: under
+    /// strong dynamics a closure's DC carries the residual's delta^2, far
+    /// more than a reset's 2*pi error, and V_pi drifts slowly anyway.
+    pub hold_limit: Phase,
+}
+
+impl GainLoopConfig {
+    /// `gain_loop_gain` of a measured gain error corrected per reset, at
+    /// the error's scale cot(phi0/2)/(2*pi) per unit, for `n_half` half periods.
+    pub fn new(p: &FogParams, n_half: usize) -> Self {
+        let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
+        let gain = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU * 16.0
+            / n_half as f64;
+        Self {
+            gain: gain.round().clamp(0.0, ((1 << 27) - 1) as f64) as i32,
+            nominal_q8: p.dac_codes_per_turn << 8,
+            min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
+            max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
+            hold_limit: phase_from_rad(0.1),
+        }
+    }
+}
+
 use super::demod::DemodSums;
-use super::modulator::Carries;
+use super::modulator::Resets;
 
 /// Returns n * (sum_j c_j * h_j) over the step (n = `n_half`), exact: no
 /// division, so no rounding that correlates with the resets. The weights are
@@ -30,10 +71,10 @@ use super::modulator::Carries;
 /// 4*n^2*h_max, under 2^31 for the layouts config accepts (n^2 * kept <
 /// 8192); the arithmetic wraps on purpose only beyond that.
 #[inline(always)]
-pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
+pub(crate) fn reset_error(sums: &DemodSums, resets: &Resets, n_half: u32) -> i32 {
     let pairs = (n_half / 2) as i32;
     let n = n_half.max(4) as i32;
-    let (neg_p, neg_m) = (carries.plus_negative, carries.minus_negative);
+    let (neg_p, neg_m) = (resets.plus_negative, resets.minus_negative);
     // dc = P + M < 2^26 and diff = P - M = first + second: P = (dc + diff)/2
     // exactly (dc + diff = 2P >= 0).
     let dc = sums.dc as i32;
@@ -47,7 +88,7 @@ pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
     if neg_m {
         weighted = weighted.wrapping_add(minus_all);
     }
-    let (plus, minus) = (moment(carries.plus, pairs), moment(carries.minus, pairs));
+    let (plus, minus) = (moment(resets.plus, pairs), moment(resets.minus, pairs));
     let (n_plus, n_minus) = (plus.count as i32, minus.count as i32);
     let (neg_p, neg_m) = (neg_p as i32, neg_m as i32);
     let w_sum = n_plus - n_minus + (neg_m - neg_p) * pairs;
@@ -75,7 +116,7 @@ pub fn reset_error(sums: &DemodSums, carries: &Carries, n_half: u32) -> i32 {
 
 /// Set bits of a carry mask and their bit-index moment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MaskMoment {
+struct MaskMoment {
     /// Number of set bits.
     pub count: u32,
     /// Sum of the set bits' indices (bit 0 counts 0).
@@ -85,7 +126,7 @@ pub struct MaskMoment {
 /// [`MaskMoment`] of the low `pairs` bits of `mask`. Up to 8 bits (16 half
 /// periods) one table lookup; up to 16 two; beyond, a loop.
 #[inline(always)]
-pub fn moment(mask: u32, pairs: i32) -> MaskMoment {
+fn moment(mask: u32, pairs: i32) -> MaskMoment {
     // Only the low `pairs` bits belong to the step.
     let mask = mask
         & u32::MAX
@@ -138,21 +179,48 @@ static BYTE_MOMENT: [u16; 256] = {
     t
 };
 
-/// New digital gain (DAC codes per turn, Q8) after one step's reset error.
-/// `err`: [`reset_error`], n x ADC LSB; `gain`: Q8 codes per unit normalised
-/// error (err/(n*H)), Q4 (config folds the 1/n in), below 2^27;
-/// `recip_h`: 2^32 / H (H = DC of one half period's kept samples, at least 2,
-/// so below 2^31).
+/// New digital gain (DAC codes per turn, Q8) after one closure's reset
+/// error. `err`: [`reset_error`], n x ADC LSB; `cfg.gain`: Q8 codes per unit
+/// normalised error (err/(n*H)), Q4 (config folds the 1/n in), below 2^27;
+/// `recip_h`: 2^32 / H (H = DC of one half period's kept samples, at least
+/// 2, so below 2^31).
 #[inline(always)]
-pub fn update(cpt_q8: u32, err: i32, gain: i32, recip_h: u32, min: u32, max: u32) -> u32 {
+pub(crate) fn update(codes_per_turn_q8: u32, err: i32, cfg: &GainLoopConfig, recip_h: u32) -> u32 {
     // err/H in Q20, saturated at |err/H| < 2^8 (n/16 times a 25 % gain error,
     // the clamp's end): only a wild start converges slower.
     let e_q20 = super::shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
     // Q20 x Q4 gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
-    let delta = ((e_q20 * gain as i64 + (1 << 23)) >> 24) as i32;
-    // cpt_q8, min, max < 2^24 (config); the subtraction saturates.
-    (cpt_q8 as i32)
+    let delta = ((e_q20 * cfg.gain as i64 + (1 << 23)) >> 24) as i32;
+    // The gain, min, max < 2^24 (config); the subtraction saturates.
+    (codes_per_turn_q8 as i32)
         .saturating_sub(delta)
-        .max(min as i32)
-        .min(max as i32) as u32
+        .max(cfg.min_q8 as i32)
+        .min(cfg.max_q8 as i32) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table-based count and index moment of carry masks against the plain
+    /// bit loop, every 8- and 16-bit mask; bits above the step's pairs ignored.
+    #[test]
+    fn mask_moment_matches_bit_loop() {
+        let naive = |m: u32, pairs: u32| {
+            let m = m & ((1u64 << pairs) - 1) as u32;
+            let weighted: u32 = (0..32).filter(|b| (m >> b) & 1 == 1).sum();
+            (m.count_ones(), weighted)
+        };
+        for m in 0..65_536u32 {
+            for pairs in [2, 4, 6, 8, 10, 16, 32] {
+                let mask = m | (m << 16) | 0x8000_0000;
+                let got = moment(mask, pairs as i32);
+                assert_eq!(
+                    (got.count, got.weighted),
+                    naive(mask, pairs),
+                    "mask {mask:#x} pairs {pairs}"
+                );
+            }
+        }
+    }
 }

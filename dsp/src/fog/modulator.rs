@@ -19,9 +19,9 @@ use crate::Phase;
 /// Where the drive phase carried out of the u32 (wrapped) in one step.
 /// Bit i (counted from bit `pairs - 1` down to 0) is pair i's plus or minus
 /// half period. Whether a carry is a reset depends on the increment's sign,
-/// fixed for all plus (or all minus) halves of a step: see [`Carries::resets`].
+/// fixed for all plus (or all minus) halves of a step: see [`Resets::resets`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Carries {
+pub(crate) struct Resets {
     pub plus: u32,
     pub minus: u32,
     /// The plus (minus) halves' increment is negative: there a reset is a
@@ -31,7 +31,7 @@ pub struct Carries {
 }
 
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Modulator {
+pub(crate) struct Modulator {
     /// Drive phase of the last DAC word written.
     theta: Phase,
 }
@@ -40,25 +40,25 @@ impl Modulator {
     /// Writes the DAC words of the next step (one per half period, starting on
     /// +phi0) and returns where the drive phase carried (the 2*pi resets).
     /// `step`: feedback step (phase LSB, taken modulo a turn); `depth`: this
-    /// step's phi0 (+ dither), phase LSB; `cpt_q8`: DAC codes per turn, Q8.
+    /// step's phi0 (+ dither), phase LSB; `codes_per_turn_q8`: DAC codes per turn, Q8.
     /// At most 64 half periods (32 pairs) are written; the reference
     /// instruments' 16 and 32 run a loop unrolled at compile time.
     #[inline(always)]
-    pub fn write_step(
+    pub(crate) fn write_closure<const H: usize>(
         &mut self,
-        step: Phase,
+        feedback: Phase,
         depth: Phase,
-        cpt_q8: u32,
+        codes_per_turn_q8: u32,
         dac: &mut [u16],
-    ) -> Carries {
-        let d_plus = depth.wrapping_sub(step);
-        let d_minus = 0u32.wrapping_sub(depth).wrapping_sub(step);
-        let (plus, minus) = match dac.len() {
-            16 => self.write::<16>(dac, d_plus, d_minus, cpt_q8),
-            32 => self.write::<32>(dac, d_plus, d_minus, cpt_q8),
-            _ => self.write_any(dac, d_plus, d_minus, cpt_q8),
+    ) -> Resets {
+        let d_plus = depth.wrapping_sub(feedback);
+        let d_minus = 0u32.wrapping_sub(depth).wrapping_sub(feedback);
+        let (plus, minus) = if H == 0 {
+            self.write_any(dac, d_plus, d_minus, codes_per_turn_q8)
+        } else {
+            self.write::<H>(dac, d_plus, d_minus, codes_per_turn_q8)
         };
-        Carries {
+        Resets {
             plus,
             minus,
             plus_negative: (d_plus as i32) < 0,
@@ -73,10 +73,10 @@ impl Modulator {
         dac: &mut [u16],
         d_plus: Phase,
         d_minus: Phase,
-        cpt_q8: u32,
+        codes_per_turn_q8: u32,
     ) -> (u32, u32) {
         match dac.first_chunk_mut::<H>() {
-            Some(dac) => self.write_any(dac, d_plus, d_minus, cpt_q8),
+            Some(dac) => self.write_any(dac, d_plus, d_minus, codes_per_turn_q8),
             None => (0, 0),
         }
     }
@@ -87,9 +87,9 @@ impl Modulator {
         dac: &mut [u16],
         d_plus: Phase,
         d_minus: Phase,
-        cpt_q8: u32,
+        codes_per_turn_q8: u32,
     ) -> (u32, u32) {
-        let cpt = cpt_q8 as u64;
+        let cpt = codes_per_turn_q8 as u64;
         let mut theta = self.theta;
         let (mut plus, mut minus) = (0u32, 0u32);
         for pair in dac.chunks_exact_mut(2).take(32) {
@@ -113,17 +113,19 @@ impl Modulator {
 
 /// DAC code of drive phase `theta` at `cpt` codes per turn (Q8): the high
 /// word of one 32x32 multiply. theta's low 8 bits are dropped first (2^-8 of
-/// a code at most); u24 * (<2^24) >> 32 stays below 2^16 while cpt_q8 < 2^24
+/// a code at most); u24 * (<2^24) >> 32 stays below 2^16 while codes_per_turn_q8 < 2^24
 /// (config clamps it).
 #[inline(always)]
 fn dac_word(theta: Phase, cpt: u64) -> u16 {
     (((theta >> 8) as u64 * cpt) >> 32) as u16
 }
 
-impl Carries {
+impl Resets {
     /// Reset weight w_j = r_j * sign_j of half period j of a step of `n_half`
     /// (r_j = +1 upward reset, -1 downward, 0 none; sign +1 on plus halves).
-    pub fn weight(&self, j: usize, n_half: usize) -> i32 {
+    /// What `gain_loop::reset_error` sums in closed form; the test's reference.
+    #[cfg(test)]
+    fn weight(&self, j: usize, n_half: usize) -> i32 {
         let pairs = n_half / 2;
         let bit = pairs.wrapping_sub(1 + j / 2) as u32;
         if j.is_multiple_of(2) {
@@ -133,5 +135,37 @@ impl Carries {
             let c = (self.minus.checked_shr(bit).unwrap_or(0) & 1) as i32;
             self.minus_negative as i32 - c
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+    /// The reset weights mark exactly the half periods whose DAC code jumps by
+    /// more than half a turn, with the jump's direction times the modulation sign.
+    #[test]
+    fn weights_mark_the_resets(feedback in any::<u32>(), depth in 0x1000_0000u32..0x7000_0000) {
+        // A DAC jump tells a reset from a plain increment only while increments
+        // stay clear of half a turn.
+        let clear = |d: u32| (d as i32).unsigned_abs() < 0x7000_0000;
+        prop_assume!(clear(depth.wrapping_sub(feedback)) && clear(0u32.wrapping_sub(depth).wrapping_sub(feedback)));
+        let codes_per_turn_q8 = 49_152u32 << 8;
+        let mut m = Modulator::default();
+        let mut dac = [0u16; 16];
+        let mut prev = 0i32;
+        for _ in 0..10 {
+            let c = m.write_closure::<16>(feedback, depth, codes_per_turn_q8, &mut dac);
+            for (j, &d) in dac.iter().enumerate() {
+                let jump = d as i32 - prev;
+                prev = d as i32;
+                let r = if jump < -24_576 { 1 } else if jump > 24_576 { -1 } else { 0 };
+                let sign = if j % 2 == 0 { 1 } else { -1 };
+                prop_assert_eq!(c.weight(j, 16), r * sign, "half {}", j);
+            }
+        }
+    }
     }
 }

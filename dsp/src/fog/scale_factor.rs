@@ -64,7 +64,7 @@ pub struct ScaleFactorConfig {
     lag_q16: i64,
     lead: DerivativeConfig,
     /// Frame-angle LSB per closure step per deg/h, Q8.
-    angle_per_step_dph_q8: i64,
+    angle_per_closure_dph_q8: i64,
     /// Table input before the first good read: the calibrated range's middle.
     t_start_q8: i32,
     pub coeffs_refused: bool,
@@ -108,7 +108,7 @@ impl ScaleFactorConfig {
             bias_slope_q16: [0; MAX_NODES],
             lag_q16: q(t.sensor_lag_s, 16),
             lead: DerivativeConfig::new(sensor_dt_s, LEAD_FILTER_TAU_S),
-            angle_per_step_dph_q8: 0,
+            angle_per_closure_dph_q8: 0,
             t_start_q8: q((t.temps_c[0] + t.temps_c[n - 1]) / 2.0, 8) as i32,
             coeffs_refused: refused,
         };
@@ -129,7 +129,7 @@ impl ScaleFactorConfig {
         let rad_s_per_dph = core::f64::consts::PI / 180.0 / 3600.0;
         let per_step =
             rad_s_per_dph * fog.n_half as f64 * fog.k_sagnac_s / crate::RAD_PER_PHASE_LSB;
-        c.angle_per_step_dph_q8 = q(per_step, 8);
+        c.angle_per_closure_dph_q8 = q(per_step, 8);
         c
     }
 
@@ -210,16 +210,16 @@ impl ScaleFactorComp {
         &self,
         cfg: &ScaleFactorConfig,
         angle: i64,
-        steps: u16,
+        closures: u16,
     ) -> (i64, FogTempWords) {
         let t = self.t_coil_q8.unwrap_or(cfg.t_start_q8);
         let (g, b_q16, out) = cfg.lookup(t);
         // |b| <= 2^26 (Q16), per-step factor < 2^26 (Q8): per step below
         // 2^36 (Q8), times steps < 2^16: below 2^52.
-        let b_step_q8 = (b_q16 as i64 * cfg.angle_per_step_dph_q8) >> 16;
+        let b_closure_q8 = (b_q16 as i64 * cfg.angle_per_closure_dph_q8) >> 16;
         // Saturating: a frame's angle is far inside i64 (2^40 LSB is 4 deg
         // at the reference coil), but no input may overflow.
-        let x = angle.saturating_sub((b_step_q8 * steps as i64) >> 8);
+        let x = angle.saturating_sub((b_closure_q8 * closures as i64) >> 8);
         let comp = x.saturating_add(mul_q32(x, g));
         let bit = |on: bool, b: u8| if on { b } else { 0 };
         let sat16 = |v: i32| v.clamp(i16::MIN as i32, i16::MAX as i32) as i16;

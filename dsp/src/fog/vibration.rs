@@ -7,6 +7,37 @@
 //! two half residuals, `bias = -(cot(phi0)/n) * d * r * (1 + r^2)` rad, and
 //! it adds no drift at rest. Derivation: docs/fog.md, "The eps^2 drift".
 
+use super::config::{ConfigError, FogParams};
+#[allow(unused_imports)] // f64 maths comes from libm where core lacks it
+use num_traits::float::Float;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VibrationConfig {
+    /// -(cot(phi0)/n_half) * 512*pi in Q[`COEFF_FRAC`]: the factor from the
+    /// in-closure slope (2^-3 phase LSB) to -(cot(phi0)/n) * slope in rad,
+    /// Q32, by one `smmul`. Below 2^31 in magnitude.
+    pub coeff: i32,
+    pub enabled: bool,
+}
+
+impl VibrationConfig {
+    /// Refused (with the correction on) when |cot(phi0)|/n_half is 0.637 or
+    /// more: the coefficient would not fit.
+    pub fn new(p: &FogParams, n_half: usize) -> Result<Self, ConfigError> {
+        let coeff = -(1.0 / p.phi0_rad.tan() / n_half as f64)
+            * 512.0
+            * core::f64::consts::PI
+            * (1u64 << COEFF_FRAC) as f64;
+        if p.vibration_correction && coeff.abs() >= 2_147_483_647.0 {
+            return Err(ConfigError::VibrationCoeff);
+        }
+        Ok(Self {
+            coeff: coeff.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            enabled: p.vibration_correction,
+        })
+    }
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 pub struct VibrationCorrection {
     /// Sub-LSB part of the correction carried to the next step (phase LSB,
@@ -22,7 +53,7 @@ const RESIDUAL_LIMIT: i32 = 1 << 28;
 /// smmul(2 * (64 r^2/2^32), pi^2/32 * 2^32).
 const R2_SCALE: i32 = 1_324_675_879; // pi^2/32 * 2^32, rounded
 
-/// Fraction bits of the coefficient (see [`crate::fog::FogConfig::vib_coeff`]).
+/// Fraction bits of the coefficient (see [`VibrationConfig::coeff`]).
 pub const COEFF_FRAC: u32 = 21;
 
 impl VibrationCorrection {

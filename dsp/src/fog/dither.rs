@@ -1,0 +1,131 @@
+//! Depth dither: the modulation depth of each closure is phi0 + r, r uniform
+//! over a few ADC codes of level, so the ADC's rounding averages out of the
+//! scale factor instead of beating with the rate (docs/fog.md, "Depth
+//! dither"). A closure of depth phi0 + r has the error slope sin(phi0 + r);
+//! the closure undoes that to first order with the gain factor 1 - r*cot(phi0).
+
+use super::config::FogParams;
+use crate::Phase;
+#[allow(unused_imports)] // f64 maths comes from libm where core lacks it
+use num_traits::float::Float;
+
+/// Phase LSB per rad.
+const LSB_PER_RAD: f64 = 4_294_967_296.0 / core::f64::consts::TAU;
+
+/// The dither's width and the gain correction that goes with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DitherConfig {
+    /// Width, bits: r spans [-2^(bits-1), 2^(bits-1)) phase LSB (0 = off,
+    /// at most 28).
+    pub bits: u32,
+    /// With r drawn as x >> (32 - bits) (x an i32), the gain factor less one
+    /// is (x * gain) >> 32 in Q32: gain = -cot(phi0) * 2*pi * 2^bits, below
+    /// 2^30 in magnitude because |r*cot(phi0)| <= 1/8.
+    pub gain: i32,
+}
+
+impl DitherConfig {
+    /// `dither_adc_codes` of half-period level at the operating point, at
+    /// the level's slope A*sin(phi0) per rad (A from the nominal DC), rounded
+    /// to a power of two and narrowed until |r*cot(phi0)| <= 1/8.
+    pub fn new(p: &FogParams) -> Self {
+        if p.dither_adc_codes <= 0.0 || p.dither_adc_codes.is_nan() {
+            return Self { bits: 0, gain: 0 };
+        }
+        let cot_phi0 = 1.0 / p.phi0_rad.tan();
+        let amplitude = p.nominal_dc_lsb / (1.0 + p.phi0_rad.cos());
+        let code_lsb = (1u32 << (16 - p.adc_bits.clamp(1, 16))) as f64;
+        let half_width_rad = p.dither_adc_codes * code_lsb / (amplitude * p.phi0_rad.sin());
+        let mut bits = ((2.0 * half_width_rad * LSB_PER_RAD).log2().round() as u32).clamp(1, 28);
+        while bits > 1 && (1u64 << (bits - 1)) as f64 / LSB_PER_RAD * cot_phi0.abs() > 0.125 {
+            bits -= 1;
+        }
+        Self {
+            bits,
+            gain: (-cot_phi0 * core::f64::consts::TAU * (1u64 << bits) as f64).round() as i32,
+        }
+    }
+
+    /// Half width w of the dither, rad (0 when off).
+    pub fn half_width_rad(&self) -> f64 {
+        if self.bits == 0 {
+            0.0
+        } else {
+            (1u64 << (self.bits - 1)) as f64 / LSB_PER_RAD
+        }
+    }
+}
+
+/// The dither's sequence: xorshift32 (a golden-ratio sequence was tried and
+/// its lines beat with the reset pattern at some rates).
+#[derive(Clone, Copy, Debug)]
+pub struct Dither {
+    state: u32,
+}
+
+impl Default for Dither {
+    fn default() -> Self {
+        Self { state: 0x9E37_79B9 }
+    }
+}
+
+impl Dither {
+    /// The next closure's depth offset r (phase LSB) and its gain factor
+    /// less one, Q32 (the dropped low bits of x are under 2^-bits of it).
+    #[inline(always)]
+    pub fn next(&mut self, cfg: &DitherConfig) -> (Phase, i32) {
+        let mut x = self.state;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.state = x;
+        // bits = 0: off.
+        let r = (x as i32).checked_shr(32 - cfg.bits).unwrap_or(0);
+        let gain_m1_q32 = ((x as i32 as i64 * cfg.gain as i64) >> 32) as i32;
+        (r as Phase, gain_m1_q32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The offsets stay inside the width, are centred, and the gain factor
+    /// matches 1 - r*cot(phi0) to the dropped bits.
+    #[test]
+    fn offsets_and_gain_follow_the_width() {
+        let p = FogParams::default();
+        let cfg = DitherConfig::new(&p);
+        assert!(cfg.bits > 0 && cfg.bits <= 28);
+        let cot = 1.0 / p.phi0_rad.tan();
+        assert!(cfg.half_width_rad() * cot.abs() <= 0.125);
+        let mut d = Dither::default();
+        let half = 1i64 << (cfg.bits - 1);
+        let (mut sum, n) = (0f64, 100_000);
+        for _ in 0..n {
+            let (r, g) = d.next(&cfg);
+            let r = r as i32 as i64;
+            assert!((-half..half).contains(&r));
+            sum += r as f64;
+            let expect = -(r as f64) / LSB_PER_RAD * cot * 4_294_967_296.0;
+            // x's dropped low bits (< 2^(32 - bits)) are worth under
+            // 2*pi*|cot(phi0)| of the Q32 factor; the shift floors one more.
+            let tol = core::f64::consts::TAU * cot.abs() + 1.0;
+            assert!((g as f64 - expect).abs() <= tol, "{g} vs {expect}");
+        }
+        // Uniform over +-half: the mean's standard error is half/sqrt(3n).
+        let se = half as f64 / (3.0 * n as f64).sqrt();
+        assert!((sum / n as f64).abs() < 5.0 * se);
+    }
+
+    #[test]
+    fn zero_codes_turn_it_off() {
+        let p = FogParams {
+            dither_adc_codes: 0.0,
+            ..FogParams::default()
+        };
+        let cfg = DitherConfig::new(&p);
+        assert_eq!((cfg.bits, cfg.gain), (0, 0));
+        assert_eq!(Dither::default().next(&cfg), (0, 0));
+    }
+}
