@@ -43,7 +43,7 @@ pub fn fog_params(dac_latency: u32) -> FogParams {
         closure_hz: CLOSURE_HZ as f64,
         tau_s: 1.0 / (CLOSURE_HZ as f64 * HALF_PERIODS as f64),
         samples_per_half: SAMPLES_PER_HALF,
-        dac_latency: dac_latency,
+        dac_latency,
         ..FogParams::default()
     }
 }

@@ -14,5 +14,5 @@ pub mod app;
 pub mod sampling;
 #[cfg(feature = "board")]
 pub mod stack;
-#[cfg(feature = "board")]
+#[cfg(feature = "qemu")]
 pub mod uart;

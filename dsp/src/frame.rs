@@ -6,12 +6,12 @@
 //! | 2 | u8 | version (3) |
 //! | 3 | u8 | payload length after this byte, CRC included (82) |
 //! | 4 | u16 | sequence number (wraps) |
-//! | 6 | u16 | fault flags, OR over the frame's steps ([`crate::fog::Faults`]) |
-//! | 8 | u16 | closure steps in this frame |
-//! | 10 | u32 | closure-step counter at the end of the frame (wraps) |
+//! | 6 | u16 | fault flags, OR over the frame's closures ([`crate::fog::Faults`]) |
+//! | 8 | u16 | closures in this frame |
+//! | 10 | u32 | closure counter at the end of the frame (wraps) |
 //! | 14 | i64 | FOG angle increment, corrected: sum of `sagnac_phase_corrected` over every half period (angle LSB = 2*pi/2^32 rad * tau / K_s) |
 //! | 22 | i64 | FOG angle increment without the epsilon-squared correction |
-//! | 30 | i32 | FOG residual of the last step, phase LSB |
+//! | 30 | i32 | FOG residual of the last closure, phase LSB |
 //! | 34 | u32 | 2*pi loop gain, DAC codes per turn, Q8 |
 //! | 38 | u32 | detector DC, kept-sample sum of one half period, ADC LSB |
 //! | 42 | i32 | RLG angle increment, counts (1/K deg, K = counts per degree) |
@@ -194,7 +194,7 @@ impl Reader<'_> {
     }
 }
 
-/// Accumulates closure steps into frames: angle increments are summed exactly,
+/// Accumulates closures into frames: angle increments are summed exactly,
 /// so a frame that could not be sent is merged back and nothing is lost.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameBuilder {
@@ -214,7 +214,7 @@ impl FrameBuilder {
         }
     }
 
-    /// Adds one closure step; returns a complete frame every `closures_per_frame` steps.
+    /// Adds one closure; returns a complete frame every `closures_per_frame` closures.
     pub fn push(&mut self, out: &crate::fog::ClosureOutput, closure_counter: u32) -> Option<Frame> {
         let a = &mut self.acc;
         a.closures = a.closures.saturating_add(1);
@@ -253,7 +253,7 @@ impl FrameBuilder {
         };
     }
 
-    /// Takes back a frame that could not be queued: its steps go into the next
+    /// Takes back a frame that could not be queued: its closures go into the next
     /// frame (flagged), which reuses its sequence number, so no angle is lost.
     pub fn restore(&mut self, f: Frame) {
         let a = &mut self.acc;

@@ -128,3 +128,8 @@ pub fn whole_periods(cfg: &FogConfig, freq: f64, settle: u64, min_s: f64) -> (u6
     let n = (periods / freq / dt).round() as u64;
     (settle, settle + n)
 }
+
+/// Closures of the reference instrument (`FogParams::default()`) in `seconds`.
+pub fn closures_in(seconds: f64) -> u64 {
+    (seconds * gyro_sp::fog::FogParams::default().closure_hz).round() as u64
+}

@@ -45,7 +45,7 @@ fn holds_lock_at_500_dps() {
 fn locks_from_rest() {
     for latency in [0, 1] {
         let mut r = rig(with_latency(latency), |_| {}, Profile::constant(0.0));
-        let m = mean_error(&mut r, 100, 12_500);
+        let m = mean_error(&mut r, 100, closures_in(1.0));
         assert!(
             m.corrected_dph.abs() < 0.01,
             "latency {latency}: bias at rest {} deg/h",
@@ -78,9 +78,9 @@ fn scale_factor_linear_within_1ppm_to_500dps() {
             },
         ]);
         let mut r = rig(FogParams::default(), |_| {}, p);
-        let start = ((ramp_s + 0.2) * 12_500.0) as u64;
+        let start = closures_in(ramp_s + 0.2);
         // 10 s per rate: the 12-bit ADC's dithered rounding averages down slowly.
-        let m = mean_error(&mut r, start, start + 10 * 12_500);
+        let m = mean_error(&mut r, start, start + closures_in(10.0));
         assert_eq!(
             m.faults_seen & Faults::OUT_OF_LOCK,
             0,
@@ -138,7 +138,7 @@ fn rate_step(latency: u32) {
     ]);
     let mut r = rig(with_latency(latency), |_| {}, p);
     let lsb = r.cfg.rad_s_per_phase_lsb();
-    let step_at = (0.01 * 12_500.0) as u64;
+    let step_at = closures_in(0.01);
     let mut errs = Vec::new();
     while r.closure_index() < step_at + 20 {
         let s = r.run_closure();
@@ -169,14 +169,14 @@ fn two_pi_loop_converges_from_5_percent_vpi_error() {
             |o| o.vpi_gain_error = err,
             Profile::constant(100.0 * DEG),
         );
-        let m = mean_error(&mut r, 6_250, 12_500);
+        let m = mean_error(&mut r, closures_in(0.5), closures_in(1.0));
         let cpt = m.last.codes_per_turn_q8 as f64 / 256.0;
         let expected = 49_152.0 / (1.0 + err);
         assert!(
             (cpt / expected - 1.0).abs() < 1e-4,
             "V_pi error {err}, latency {latency}: codes per turn {cpt}, expected {expected}"
         );
-        let late = mean_error(&mut r, 12_500, 25_000);
+        let late = mean_error(&mut r, closures_in(1.0), closures_in(2.0));
         assert!(
             late.corrected_dph.abs() < 0.5,
             "V_pi error {err}, latency {latency}: bias {} deg/h after convergence",

@@ -175,7 +175,7 @@ fn correction_adds_no_drift_at_rest_with_noise() {
             },
             gyro_sim::Profile::constant(0.0),
         );
-        let m = mean_error(&mut r, 100, 100 + 5 * 12_500);
+        let m = mean_error(&mut r, 100, 100 + closures_in(5.0));
         let moved = m.corrected_dph - m.raw_dph;
         println!(
             "seed {seed}: correction moved the mean by {moved:e} deg/h (raw bias {:.4})",

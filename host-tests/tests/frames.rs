@@ -8,10 +8,10 @@ use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
 use gyro_sp::rlg::RlgWords;
 use proptest::prelude::*;
 
-fn out(step: i64) -> ClosureOutput {
+fn out(sagnac_phase: i64) -> ClosureOutput {
     ClosureOutput {
-        step,
-        sagnac_phase_corrected: step - 3,
+        sagnac_phase,
+        sagnac_phase_corrected: sagnac_phase - 3,
         ..ClosureOutput::default()
     }
 }
@@ -130,8 +130,8 @@ proptest! {
         let mut dac = [0u16; 16];
         for _ in 0..3 {
             let out = fog.process(&cfg, &adc, over_range, &mut dac);
-            prop_assert!(out.codes_per_turn_q8 >= cfg.cpt_min_q8 && out.codes_per_turn_q8 <= cfg.cpt_max_q8);
-            prop_assert!(dac.iter().all(|&d| u32::from(d) <= cfg.cpt_max_q8 >> 8));
+            prop_assert!(out.codes_per_turn_q8 >= cfg.gain_loop.min_q8 && out.codes_per_turn_q8 <= cfg.gain_loop.max_q8);
+            prop_assert!(dac.iter().all(|&d| u32::from(d) <= cfg.gain_loop.max_q8 >> 8));
             if adc.len() < cfg.n_samples || over_range {
                 prop_assert!(out.faults.has(gyro_sp::fog::Faults::ADC_SATURATION));
             }

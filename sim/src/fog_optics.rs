@@ -1,5 +1,5 @@
 //! Interferometer, modulator, photodetector and ADC of a closed-loop FOG
-//! (docs/fog.md), one closure step at a time.
+//! (docs/fog.md), one closure at a time.
 //!
 //! - Modulator: DAC code -> phase with the true V_pi (a gain error that can drift).
 //! - Coil transit: half period j sees `phi(code_j) - phi(code_(j-1))` (tau delay).
@@ -110,7 +110,7 @@ where
         }
     }
 
-    /// Simulates one closure step: DAC words `dac` (one per half period) applied
+    /// Simulates one closure: DAC words `dac` (one per half period) applied
     /// while the Sagnac phase is `sagnac[j]` (rad) in half period j; writes the
     /// ADC samples into `adc` (`samples_per_half` per half period). Returns the
     /// ADC analog-watchdog flag: a conversion fell outside [AWD_LOW, AWD_HIGH].

@@ -19,23 +19,23 @@ pub struct FogRig<F> {
     pub bias_rad_s: F,
     k_sagnac: F,
     closure_index: u64,
-    /// DAC buffers: [0] is applied this step and receives the closure's new
-    /// words. With one step of DAC latency the two swap after each step (the
-    /// hw DMA ping-pong: words written now are applied the step after next).
+    /// DAC buffers: [0] is applied this closure and receives the closure's new
+    /// words. With one closure of DAC latency the two swap after each closure (the
+    /// hw DMA ping-pong: words written now are applied the closure after next).
     dac: [[u16; MAX_HALF]; 2],
     adc: [u16; MAX_HALF * MAX_SAMPLES_PER_HALF],
     sagnac: [F; MAX_HALF],
-    /// The ADC analog watchdog fired during the last simulated step.
+    /// The ADC analog watchdog fired during the last simulated closure.
     adc_over_range: bool,
 }
 
-/// One step of the rig: the core's output and the truth.
+/// One closure of the rig: the core's output and the truth.
 #[derive(Clone, Copy, Debug)]
 pub struct RigClosure<F> {
     pub out: ClosureOutput,
-    /// Mean true rate over the step (of the per-half-period rates), rad/s.
+    /// Mean true rate over the closure (of the per-half-period rates), rad/s.
     pub true_rate: F,
-    /// Time at the end of the step, s.
+    /// Time at the end of the closure, s.
     pub t_end: F,
 }
 
@@ -68,15 +68,15 @@ where
         self.closure_index
     }
 
-    /// Runs one closure step.
+    /// Runs one closure.
     pub fn run_closure(&mut self) -> RigClosure<F> {
         let true_rate = self.simulate_optics();
         let out = self.process_core();
         self.finish_step(out, true_rate)
     }
 
-    /// First half of a step: the optics produce the ADC samples of the DAC words
-    /// now applied. Returns the mean true rate over the step, rad/s.
+    /// First half of a closure: the optics produce the ADC samples of the DAC words
+    /// now applied. Returns the mean true rate over the closure, rad/s.
     pub fn simulate_optics(&mut self) -> F {
         let n = self.cfg.n_half;
         let tau = F::from(self.cfg.params.tau_s).unwrap_or(F::zero());
@@ -97,7 +97,7 @@ where
         sum / F::from(n).unwrap_or(F::one())
     }
 
-    /// Second half: the firmware's closure step on those samples (this is what
+    /// Second half: the firmware's closure on those samples (this is what
     /// the interrupt runs on the MCU).
     #[inline(never)]
     pub fn process_core(&mut self) -> ClosureOutput {
@@ -110,7 +110,7 @@ where
         )
     }
 
-    /// Completes a step run as `simulate_optics` + `process_core`.
+    /// Completes a closure run as `simulate_optics` + `process_core`.
     pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigClosure<F> {
         self.closure_index += 1;
         if self.cfg.params.dac_latency != 0 {

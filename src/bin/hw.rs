@@ -110,6 +110,14 @@ pub struct Housekeeping {
     temps: Producer<'static, Temperatures, 2>,
     coil: Producer<'static, Option<i32>, 2>,
     watchdog: IndependentWatchdog,
+    /// The HAL's handles of the sampling peripherals, kept so nothing else
+    /// can take them; the closure drives them through `Sampling`.
+    _sampling: (
+        Adc<pac::ADC1>,
+        CounterHz<pac::TIM1>,
+        CounterHz<pac::TIM2>,
+        Spi<pac::SPI1, false, u16>,
+    ),
 }
 
 #[rtic::app(device = stm32f4xx_hal::pac, peripherals = true)]
@@ -240,8 +248,8 @@ mod app {
         let sampling = Sampling::new(
             dp.DMA2,
             // SAFETY: the HAL's Adc configured the converter and is kept
-            // (never used again); this handle touches only the analog
-            // watchdog, which the HAL never writes.
+            // (never used again, `Housekeeping::_sampling`); this handle
+            // touches only the analog watchdog, which the HAL never writes.
             unsafe { pac::ADC1::steal() },
             adc_dr,
             // SAFETY: the NSS output and TX DMA bits, which the HAL's Spi
@@ -250,7 +258,6 @@ mod app {
             cx.local.adc_buf,
             dac_buf,
         );
-        core::mem::forget(adc);
         let mut tim1 = dp.TIM1.counter_hz(&mut rcc);
         let mut tim2 = dp.TIM2.counter_hz(&mut rcc);
         // SAFETY: the DMA request and trigger bits, which the HAL never writes.
@@ -283,7 +290,6 @@ mod app {
         {
             reset()
         }
-        core::mem::forget((tim1, tim2, spi));
         defmt::info!(
             "gyro-fw hw: FOG closure at {} Hz, RLG update at {} Hz",
             CLOSURE_HZ,
@@ -317,6 +323,7 @@ mod app {
                     temps: temps_tx,
                     coil: coil_tx,
                     watchdog,
+                    _sampling: (adc, tim1, tim2, spi),
                 },
             },
         )

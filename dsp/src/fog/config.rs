@@ -97,22 +97,22 @@ impl Default for FogParams {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ConfigError {
     /// Closure period is not a whole multiple of 4 half periods (each half of a
-    /// step holds whole +-phi0 pairs), or too many.
+    /// closure holds whole +-phi0 pairs), or too many.
     HalfPeriods,
     /// Samples per half period or skipped samples out of range, or more
-    /// kept samples per step than the 2*pi loop's 32-bit estimate holds
+    /// kept samples per closure than the 2*pi loop's 32-bit estimate holds
     /// (n_half^2 * kept < 8192: 16 half periods take up to 15 kept samples,
     /// 32 up to 7, 64 one).
     Samples,
     /// phi0 outside [0.1, pi - 0.1] rad.
     Phi0,
-    /// Loop gain outside (0, 2) (the one-step integrator is unstable beyond),
-    /// or DAC latency above one step.
+    /// Loop gain outside (0, 2) (the one-closure integrator is unstable beyond),
+    /// or DAC latency above one closure.
     LoopGain,
     /// DAC codes per turn leave no headroom for the 2*pi loop in 16 bits.
     DacRange,
     /// The epsilon-squared correction's coefficient |cot(phi0)|/n_half is 0.637
-    /// or more (phi0 within 0.37 rad of 0 or pi at 4 half periods per step,
+    /// or more (phi0 within 0.37 rad of 0 or pi at 4 half periods per closure,
     /// within 0.19 rad at 8): turn the correction off or use more half periods.
     VibrationCoeff,
     /// Non-finite or non-positive physical parameter, or a nominal detector
@@ -262,12 +262,12 @@ impl FogConfig {
         self.n_half as f64 * self.params.tau_s
     }
 
-    /// Rate (rad/s) of one phase LSB of the feedback step.
+    /// Rate (rad/s) of one phase LSB of the feedback phase.
     pub fn rad_s_per_phase_lsb(&self) -> f64 {
         crate::RAD_PER_PHASE_LSB / self.k_sagnac_s
     }
 
-    /// Angle (rad) of one unit of the angle-increment word (one step LSB held
+    /// Angle (rad) of one unit of the angle-increment word (one closure LSB held
     /// for one half period).
     pub fn rad_per_angle_lsb(&self) -> f64 {
         self.rad_s_per_phase_lsb() * self.params.tau_s

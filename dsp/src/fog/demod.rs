@@ -1,6 +1,6 @@
-//! Synchronous demodulation of one closure step of ADC samples.
+//! Synchronous demodulation of one closure of ADC samples.
 //!
-//! Half period j has modulation sign +1 for even j, -1 for odd j (each step starts
+//! Half period j has modulation sign +1 for even j, -1 for odd j (each closure starts
 //! on +phi0, the convention the epsilon-squared derivation uses). The first
 //! `skip` samples after each edge carry the detector transient and are dropped.
 //! The same pass sums the half periods where the modulator's drive phase
@@ -17,14 +17,14 @@ use super::modulator::Resets;
 pub const AWD_LOW: u16 = 0x0010;
 pub const AWD_HIGH: u16 = 0xFFE0;
 
-/// Sums of one step; units are ADC LSB summed over the kept samples.
+/// Sums of one closure; units are ADC LSB summed over the kept samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct DemodSums {
-    /// sum(sign_j * h_j) over the first half of the step.
+    /// sum(sign_j * h_j) over the first half of the closure.
     pub first: i32,
-    /// sum(sign_j * h_j) over the second half of the step.
+    /// sum(sign_j * h_j) over the second half of the closure.
     pub second: i32,
-    /// sum(h_j): the detector DC over the step.
+    /// sum(h_j): the detector DC over the closure.
     pub dc: u32,
     /// sum(h_j) over the plus half periods whose drive phase carried, less
     /// the same over the minus half periods (the 2*pi loop needs only the
@@ -66,7 +66,7 @@ fn kept<const S: usize>(half: &[u16]) -> u32 {
     half.iter().skip(S).map(|&x| x as u32).sum()
 }
 
-/// Plus- and minus-half sums of one half of a step (`N`-sample halves), with
+/// Plus- and minus-half sums of one half of a closure (`N`-sample halves), with
 /// the carried halves' sums; pair k's carry bits are bit `31 - first - k` of
 /// the masks. The carry selects by multiplying with the mask bit (no branch;
 /// LLVM turns it into a conditional add, three instructions per half).

@@ -50,11 +50,11 @@ impl GainLoopConfig {
 use super::demod::DemodSums;
 use super::modulator::Resets;
 
-/// Returns n * (sum_j c_j * h_j) over the step (n = `n_half`), exact: no
+/// Returns n * (sum_j c_j * h_j) over the closure (n = `n_half`), exact: no
 /// division, so no rounding that correlates with the resets. The weights are
 /// c_j = w_j - W/n - (R/n)*sign_j, w_j = r_j * sign_j, r_j the reset
 /// direction (see [`Carries::weight`]), W = sum w_j, R = sum r_j: the mean
-/// level and the step's common residual (mean of sign_j * h_j: the main
+/// level and the closure's common residual (mean of sign_j * h_j: the main
 /// loop's error, or the lag under acceleration) drop out, so only the
 /// resets' own phase error remains.
 ///
@@ -95,7 +95,7 @@ pub(crate) fn reset_error(sums: &DemodSums, resets: &Resets, n_half: u32) -> i32
     let r_sum = n_plus + n_minus - (neg_p + neg_m) * pairs;
     // S1: pair i's two halves (bit P-1-i) both sit at 2i + 1 - P, and
     // r = carry - [negative] on both (a minus half's r is -w); the constant
-    // parts sum to zero over the step.
+    // parts sum to zero over the closure.
     let s1 = (pairs - 1) * (n_plus + n_minus) - 2 * (plus.weighted + minus.weighted) as i32;
     // 4*(first - second)*S1/n, rounded: the product (below 2^57) in 64 bits.
     let slope = sums.first.wrapping_sub(sums.second) as i64 * s1 as i64;
@@ -127,7 +127,7 @@ struct MaskMoment {
 /// periods) one table lookup; up to 16 two; beyond, a loop.
 #[inline(always)]
 fn moment(mask: u32, pairs: i32) -> MaskMoment {
-    // Only the low `pairs` bits belong to the step.
+    // Only the low `pairs` bits belong to the closure.
     let mask = mask
         & u32::MAX
             .checked_shr(32 - pairs.clamp(0, 32) as u32)
@@ -203,7 +203,7 @@ mod tests {
     use super::*;
 
     /// The table-based count and index moment of carry masks against the plain
-    /// bit loop, every 8- and 16-bit mask; bits above the step's pairs ignored.
+    /// bit loop, every 8- and 16-bit mask; bits above the closure's pairs ignored.
     #[test]
     fn mask_moment_matches_bit_loop() {
         let naive = |m: u32, pairs: u32| {

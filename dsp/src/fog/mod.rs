@@ -2,9 +2,9 @@
 //! demodulation, digital serrodyne feedback, the 2*pi gain loop and the online
 //! epsilon-squared (vibration rectification) correction. See docs/fog.md.
 //!
-//! Data flow per closure step (one interrupt, `n_half` half periods of tau):
+//! Data flow per closure (one interrupt, `n_half` half periods of tau):
 //! ADC batch -> [`demod`] -> main loop ([`closure`]) and [`gain_loop`] ->
-//! [`modulator`] writes the DAC words of the next step; [`vibration`] corrects
+//! [`modulator`] writes the DAC words of the next closure; [`vibration`] corrects
 //! the output; [`faults`] flags what went wrong. At the frame rate,
 //! [`scale_factor`] applies the scale factor and bias over coil temperature.
 
@@ -24,7 +24,7 @@ pub use closure::{ClosureOutput, FogLoop};
 pub use config::{FogConfig, FogParams};
 pub use faults::Faults;
 
-/// Most half periods per closure step (6.25 kHz closure at tau = 5 us is 32).
+/// Most half periods per closure (6.25 kHz closure at tau = 5 us is 32).
 pub const MAX_HALF: usize = 64;
 /// Most ADC samples per half period.
 pub const MAX_SAMPLES_PER_HALF: usize = 16;

@@ -2,24 +2,24 @@
 //! ramp, one DAC word per half period.
 //!
 //! The drive phase theta is a wrapping [`Phase`]; its wrap-around is the 2*pi reset.
-//! Per half period theta moves by `sign*phi0 - step`, so the interferometer sees
-//! `phi_s - step + sign*phi0` and the loop drives `step` to the Sagnac phase.
+//! Per half period theta moves by `sign*phi0 - feedback`, so the interferometer sees
+//! `phi_s - feedback + sign*phi0` and the loop drives `feedback` to the Sagnac phase.
 //! The DAC code is theta scaled by the digital gain (codes per turn, trimmed by the
 //! 2*pi loop).
 //!
-//! Depth dither: the depth of each step is phi0 + r_k, r_k pseudo-random and
+//! Depth dither: the depth of each closure is phi0 + r_k, r_k pseudo-random and
 //! uniform. Both half periods' detector levels move together by about
 //! `A*sin(phi0)*r_k`, so their difference (the error) is unchanged while the ADC
-//! rounding is averaged away over steps: without it a noise-free or quiet
+//! rounding is averaged away over closures: without it a noise-free or quiet
 //! detector leaves the loop a dead zone of half an ADC LSB (about 4e-4 rad with a
 //! 12-bit ADC).
 
 use crate::Phase;
 
-/// Where the drive phase carried out of the u32 (wrapped) in one step.
+/// Where the drive phase carried out of the u32 (wrapped) in one closure.
 /// Bit i (counted from bit `pairs - 1` down to 0) is pair i's plus or minus
 /// half period. Whether a carry is a reset depends on the increment's sign,
-/// fixed for all plus (or all minus) halves of a step: see [`Resets::resets`].
+/// fixed for all plus (or all minus) halves of a closure: see `Resets::weight`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Resets {
     pub plus: u32,
@@ -37,10 +37,10 @@ pub(crate) struct Modulator {
 }
 
 impl Modulator {
-    /// Writes the DAC words of the next step (one per half period, starting on
+    /// Writes the DAC words of the next closure (one per half period, starting on
     /// +phi0) and returns where the drive phase carried (the 2*pi resets).
-    /// `step`: feedback step (phase LSB, taken modulo a turn); `depth`: this
-    /// step's phi0 (+ dither), phase LSB; `codes_per_turn_q8`: DAC codes per turn, Q8.
+    /// `feedback`: feedback phase (phase LSB, taken modulo a turn); `depth`: this
+    /// closure's phi0 (+ dither), phase LSB; `codes_per_turn_q8`: DAC codes per turn, Q8.
     /// At most 64 half periods (32 pairs) are written; the reference
     /// instruments' 16 and 32 run a loop unrolled at compile time.
     #[inline(always)]
@@ -121,7 +121,7 @@ fn dac_word(theta: Phase, cpt: u64) -> u16 {
 }
 
 impl Resets {
-    /// Reset weight w_j = r_j * sign_j of half period j of a step of `n_half`
+    /// Reset weight w_j = r_j * sign_j of half period j of a closure of `n_half`
     /// (r_j = +1 upward reset, -1 downward, 0 none; sign +1 on plus halves).
     /// What `gain_loop::reset_error` sums in closed form; the test's reference.
     #[cfg(test)]

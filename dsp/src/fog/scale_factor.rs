@@ -14,7 +14,7 @@
 //!   the coil), dT/dt from a [`Derivative`] with a [`LEAD_FILTER_TAU_S`]
 //!   time constant, Q32 degC/s; the lag Q16 s;
 //! - g - 1: i32, 2^-32 per LSB (0.00023 ppm), within +-2 %;
-//! - bias: i32 Q16 deg/h; per closure step in frame-angle LSB, Q8;
+//! - bias: i32 Q16 deg/h; per closure in frame-angle LSB, Q8;
 //! - angles: the frame's i64 angle LSB (2*pi/2^32 rad * tau / K_s).
 //!
 //! Faults: a bad coil sensor ([`crate::sensor`]) holds the last good
@@ -63,7 +63,7 @@ pub struct ScaleFactorConfig {
     /// Sensor lag, Q16 s.
     lag_q16: i64,
     lead: DerivativeConfig,
-    /// Frame-angle LSB per closure step per deg/h, Q8.
+    /// Frame-angle LSB per closure per deg/h, Q8.
     angle_per_closure_dph_q8: i64,
     /// Table input before the first good read: the calibrated range's middle.
     t_start_q8: i32,
@@ -203,7 +203,7 @@ impl ScaleFactorComp {
         self.t_coil_q8 = Some(t_coil);
     }
 
-    /// Compensates one frame's angle increment (`steps` closure steps):
+    /// Compensates one frame's angle increment (`closures` closures):
     /// returns `(y - b) * g` and the words that say what was applied.
     #[inline]
     pub fn compensate(
@@ -214,8 +214,8 @@ impl ScaleFactorComp {
     ) -> (i64, FogTempWords) {
         let t = self.t_coil_q8.unwrap_or(cfg.t_start_q8);
         let (g, b_q16, out) = cfg.lookup(t);
-        // |b| <= 2^26 (Q16), per-step factor < 2^26 (Q8): per step below
-        // 2^36 (Q8), times steps < 2^16: below 2^52.
+        // |b| <= 2^26 (Q16), per-closure factor < 2^26 (Q8): per closure below
+        // 2^36 (Q8), times closures < 2^16: below 2^52.
         let b_closure_q8 = (b_q16 as i64 * cfg.angle_per_closure_dph_q8) >> 16;
         // Saturating: a frame's angle is far inside i64 (2^40 LSB is 4 deg
         // at the reference coil), but no input may overflow.

@@ -40,7 +40,7 @@ impl VibrationConfig {
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct VibrationCorrection {
-    /// Sub-LSB part of the correction carried to the next step (phase LSB,
+    /// Sub-LSB part of the correction carried to the next closure (phase LSB,
     /// Q32, in [0, 1)).
     frac: u32,
 }
@@ -57,11 +57,11 @@ const R2_SCALE: i32 = 1_324_675_879; // pi^2/32 * 2^32, rounded
 pub const COEFF_FRAC: u32 = 21;
 
 impl VibrationCorrection {
-    /// Takes this step's slope d (2^-3 phase LSB: the i32 range is +-0.37 rad,
+    /// Takes this closure's slope d (2^-3 phase LSB: the i32 range is +-0.37 rad,
     /// beyond which the loop is not tracking and the correction means
     /// nothing), its mean residual r (phase LSB) and the coefficient
     /// -(cot(phi0)/n) * 512*pi in Q[`COEFF_FRAC`]; returns the bias to
-    /// subtract from the output step, whole phase LSB (the fraction is
+    /// subtract from the output phase, whole phase LSB (the fraction is
     /// carried, no loss; |bias| < 2^27).
     #[inline(always)]
     pub fn update(&mut self, slope_q3: i32, residual: i32, coeff: i32) -> i32 {
@@ -76,7 +76,7 @@ impl VibrationCorrection {
         // v = u*(1 + q), one `smmla`; |v| < 0.28 * 2^32.
         let v = u + smmul(q, u);
         // bias = r * v, phase LSB in Q32 (|r * v| < 2^59); the fraction below
-        // one LSB waits for the next step.
+        // one LSB waits for the next closure.
         let total = self.frac as i64 + r as i64 * v as i64;
         self.frac = total as u32;
         (total >> 32) as i32
