@@ -6,7 +6,7 @@
 //! | 2 | u8 | version (3) |
 //! | 3 | u8 | payload length after this byte, CRC included (82) |
 //! | 4 | u16 | sequence number (wraps) |
-//! | 6 | u16 | fault flags, OR over the frame's closures ([`crate::fog::Faults`]) |
+//! | 6 | u16 | fault flags, OR over the frame's closures ([`Faults`]) |
 //! | 8 | u16 | closures in this frame |
 //! | 10 | u32 | closure counter at the end of the frame (wraps) |
 //! | 14 | i64 | FOG angle increment, corrected: sum of `sagnac_phase_corrected` over every half period (angle LSB = 2*pi/2^32 rad * tau / K_s) |
@@ -18,22 +18,25 @@
 //! | 46 | i32 | RLG compensated rate over the frame, micro-deg/s |
 //! | 50 | i32 | RLG thermal bias B_TC in use, Q16 deg/h |
 //! | 54 | i16 x3 | RLG temperatures in use: monoblock A, monoblock B, case; Q8 degC |
-//! | 60 | u8 | RLG flags ([`crate::rlg::thermal::flags`]: sensor A, B, case bad; coefficients refused) |
+//! | 60 | u8 | RLG flags ([`RlgFlags`]: sensor A, B, case bad; coefficients refused) |
 //! | 61 | u8 | reserved (0) |
 //! | 62 | i64 | FOG angle increment compensated: the corrected angle with the scale factor and bias over coil temperature applied ([`crate::fog::scale_factor`]), same LSB |
 //! | 70 | i32 | FOG scale-factor correction in use: output times 1 + x/2^32 |
 //! | 74 | i32 | FOG bias removed, Q16 deg/h |
 //! | 78 | i16 | FOG coil temperature the table was read at (sensor plus lag lead), Q8 degC |
 //! | 80 | i16 | FOG coil sensor value in use (held while bad), Q8 degC |
-//! | 82 | u8 | FOG temperature flags ([`crate::fog::scale_factor::flags`]: coil sensor bad, out of the calibrated range, table refused) |
+//! | 82 | u8 | FOG temperature flags ([`FogTempFlags`]: coil sensor bad, out of the calibrated range, table refused) |
 //! | 83 | u8 | reserved (0) |
 //! | 84 | u16 | CRC-16/CCITT-FALSE over bytes 2..84 |
 //!
 //! Version 1 (44 bytes) was the FOG part alone; version 2 (64 bytes) ended
 //! after byte 61.
 
-use crate::fog::scale_factor::{FogTempWords, ScaleFactorComp, ScaleFactorConfig};
-use crate::rlg::RlgWords;
+use crate::fog::closure::ClosureOutput;
+use crate::fog::faults::Faults;
+use crate::fog::scale_factor::{FogTempFlags, FogTempWords, ScaleFactorComp, ScaleFactorConfig};
+use crate::rlg::channel::RlgWords;
+use crate::rlg::thermal::RlgFlags;
 use crc::{Crc, CRC_16_IBM_3740};
 
 pub const FRAME_LEN: usize = 86;
@@ -44,7 +47,7 @@ const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Frame {
     pub seq: u16,
-    pub faults: u16,
+    pub faults: Faults,
     pub closures: u16,
     pub closure_counter: u32,
     pub fog_angle: i64,
@@ -75,7 +78,7 @@ impl Frame {
         w.put(&SYNC);
         w.put(&[VERSION, (FRAME_LEN - 4) as u8]);
         w.put(&self.seq.to_le_bytes());
-        w.put(&self.faults.to_le_bytes());
+        w.put(&self.faults.bits().to_le_bytes());
         w.put(&self.closures.to_le_bytes());
         w.put(&self.closure_counter.to_le_bytes());
         w.put(&self.fog_angle.to_le_bytes());
@@ -90,14 +93,14 @@ impl Frame {
         w.put(&g.t_mono_a_q8.to_le_bytes());
         w.put(&g.t_mono_b_q8.to_le_bytes());
         w.put(&g.t_case_q8.to_le_bytes());
-        w.put(&[g.flags, 0]);
+        w.put(&[g.flags.bits(), 0]);
         w.put(&self.fog_angle_comp.to_le_bytes());
         let t = &self.fog_temp;
         w.put(&t.sf_corr_q32.to_le_bytes());
         w.put(&t.bias_q16_dph.to_le_bytes());
         w.put(&t.t_coil_q8.to_le_bytes());
         w.put(&t.t_sensor_q8.to_le_bytes());
-        w.put(&[t.flags, 0]);
+        w.put(&[t.flags.bits(), 0]);
         let crc = CRC16.checksum(b.get(2..FRAME_LEN - 2).unwrap_or(&[]));
         if let Some(t) = b.get_mut(FRAME_LEN - 2..) {
             t.copy_from_slice(&crc.to_le_bytes());
@@ -126,7 +129,7 @@ impl Frame {
         let mut r = Reader { buf: b, pos: 4 };
         Ok(Self {
             seq: u16::from_le_bytes(r.take()),
-            faults: u16::from_le_bytes(r.take()),
+            faults: Faults::from_bits_retain(u16::from_le_bytes(r.take())),
             closures: u16::from_le_bytes(r.take()),
             closure_counter: u32::from_le_bytes(r.take()),
             fog_angle: i64::from_le_bytes(r.take()),
@@ -141,7 +144,7 @@ impl Frame {
                 t_mono_a_q8: i16::from_le_bytes(r.take()),
                 t_mono_b_q8: i16::from_le_bytes(r.take()),
                 t_case_q8: i16::from_le_bytes(r.take()),
-                flags: r.take::<1>()[0],
+                flags: RlgFlags::from_bits_retain(r.take::<1>()[0]),
             },
             fog_angle_comp: {
                 r.pos += 1; // reserved byte 61
@@ -152,7 +155,7 @@ impl Frame {
                 bias_q16_dph: i32::from_le_bytes(r.take()),
                 t_coil_q8: i16::from_le_bytes(r.take()),
                 t_sensor_q8: i16::from_le_bytes(r.take()),
-                flags: r.take::<1>()[0],
+                flags: FogTempFlags::from_bits_retain(r.take::<1>()[0]),
             },
         })
     }
@@ -215,10 +218,10 @@ impl FrameBuilder {
     }
 
     /// Adds one closure; returns a complete frame every `closures_per_frame` closures.
-    pub fn push(&mut self, out: &crate::fog::ClosureOutput, closure_counter: u32) -> Option<Frame> {
+    pub fn push(&mut self, out: &ClosureOutput, closure_counter: u32) -> Option<Frame> {
         let a = &mut self.acc;
         a.closures = a.closures.saturating_add(1);
-        a.faults |= out.faults.0;
+        a.faults |= out.faults;
         a.closure_counter = closure_counter;
         a.fog_angle = a
             .fog_angle
@@ -258,7 +261,7 @@ impl FrameBuilder {
     pub fn restore(&mut self, f: Frame) {
         let a = &mut self.acc;
         a.closures = a.closures.saturating_add(f.closures);
-        a.faults |= f.faults | crate::fog::Faults::QUEUE_FULL;
+        a.faults |= f.faults | Faults::QUEUE_FULL;
         a.fog_angle = a.fog_angle.wrapping_add(f.fog_angle);
         a.fog_angle_raw = a.fog_angle_raw.wrapping_add(f.fog_angle_raw);
         a.rlg.delta_counts = a.rlg.delta_counts.wrapping_add(f.rlg.delta_counts);

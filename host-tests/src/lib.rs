@@ -2,7 +2,7 @@
 //! simulated gyro, with the truth alongside.
 
 use gyro_sim::{FogRig, OpticsParams, Profile, Segment};
-use gyro_sp::fog::{ClosureOutput, FogConfig, FogParams};
+use gyro_sp::fog::{ClosureOutput, Faults, FogConfig, FogParams};
 
 pub const DEG: f64 = std::f64::consts::PI / 180.0;
 pub const DPH: f64 = 3600.0 / DEG;
@@ -29,12 +29,12 @@ pub struct Means {
     pub corrected_dph: f64,
     pub raw_dph: f64,
     pub last: ClosureOutput,
-    pub faults_seen: u16,
+    pub faults_seen: Faults,
 }
 
 pub fn mean_error(rig: &mut FogRig<f64>, from: u64, to: u64) -> Means {
     let lsb = rig.cfg.rad_s_per_phase_lsb();
-    let (mut c, mut r, mut n, mut faults) = (0.0, 0.0, 0.0, 0u16);
+    let (mut c, mut r, mut n, mut faults) = (0.0, 0.0, 0.0, Faults::empty());
     let mut last = ClosureOutput::default();
     while rig.closure_index() < to {
         let k = rig.closure_index();
@@ -43,7 +43,7 @@ pub fn mean_error(rig: &mut FogRig<f64>, from: u64, to: u64) -> Means {
             c += s.out.sagnac_phase_corrected as f64 * lsb - s.true_rate;
             r += s.out.sagnac_phase as f64 * lsb - s.true_rate;
             n += 1.0;
-            faults |= s.out.faults.0;
+            faults |= s.out.faults;
         }
         last = s.out;
     }

@@ -4,7 +4,7 @@
 
 use gyro_sim::CoilThermal;
 use gyro_sp::fog::scale_factor::{
-    flags, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable, LEAD_FILTER_TAU_S,
+    FogTempFlags, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable, LEAD_FILTER_TAU_S,
 };
 use gyro_sp::fog::{FogConfig, FogParams};
 use proptest::prelude::*;
@@ -61,7 +61,7 @@ fn compensation_inverts_the_model() {
                 (c as f64 - want).abs() <= tol,
                 "T {tc} w {w}: {c} vs {want} (tol {tol})"
             );
-            assert_eq!(words.flags, 0);
+            assert_eq!(words.flags, FogTempFlags::empty());
             assert_eq!(words.t_coil_q8 as i32, (tc * 256.0_f64).round() as i32);
             let corr = words.sf_corr_q32 as f64 / 4_294_967_296.0;
             assert!(
@@ -80,7 +80,7 @@ fn clamped_outside_the_calibrated_range_and_flagged() {
     for (tc, node) in [(-50.0, 0usize), (75.0, 2)] {
         let comp = at(&cfg, tc);
         let (_, w) = comp.compensate(&cfg, 1 << 40, 25);
-        assert_eq!(w.flags, flags::OUT_OF_RANGE, "{tc}");
+        assert_eq!(w.flags, FogTempFlags::OUT_OF_RANGE, "{tc}");
         let g = 1.0 / (1.0 + t.sf_ppm[node] * 1e-6) - 1.0;
         assert!((w.sf_corr_q32 as f64 / 4_294_967_296.0 - g).abs() < 1e-9);
         assert_eq!(w.bias_q16_dph, (t.bias_dph[node] * 65_536.0).round() as i32);
@@ -131,25 +131,25 @@ fn bad_sensor_holds_and_flags() {
     let mut c = ScaleFactorComp::default();
     // Before any read: the middle of the calibrated range, flagged.
     let (_, w) = c.compensate(&cfg, 1 << 30, 25);
-    assert_eq!(w.flags, flags::COIL_SENSOR);
+    assert_eq!(w.flags, FogTempFlags::COIL_SENSOR);
     assert_eq!(w.t_coil_q8 as i32, 10 * 256);
     c.update_temperature(&cfg, Some(30 * 256));
-    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, 0);
+    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, FogTempFlags::empty());
     // A failed read, then nonsense (above the TMP117's range): held, flagged.
     for read in [None, Some(200 * 256), Some(-60 * 256)] {
         c.update_temperature(&cfg, read);
         let (_, w) = c.compensate(&cfg, 0, 25);
-        assert_eq!(w.flags, flags::COIL_SENSOR, "{read:?}");
+        assert_eq!(w.flags, FogTempFlags::COIL_SENSOR, "{read:?}");
         assert_eq!(w.t_sensor_q8 as i32, 30 * 256);
     }
     // Back: cleared.
     c.update_temperature(&cfg, Some(31 * 256));
-    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, 0);
+    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, FogTempFlags::empty());
     // Stuck: the same value for STUCK_READS reads.
     for _ in 0..=gyro_sp::sensor::STUCK_READS {
         c.update_temperature(&cfg, Some(31 * 256));
     }
-    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, flags::COIL_SENSOR);
+    assert_eq!(c.compensate(&cfg, 0, 25).1.flags, FogTempFlags::COIL_SENSOR);
 }
 
 #[test]
@@ -164,7 +164,7 @@ fn refused_table_compensates_nothing_and_flags() {
     let comp = at(&cfg, 25.0);
     let (c, w) = comp.compensate(&cfg, 123_456_789_012, 25);
     assert_eq!(c, 123_456_789_012);
-    assert_eq!(w.flags, flags::COEFFS_REFUSED);
+    assert_eq!(w.flags, FogTempFlags::COEFFS_REFUSED);
     // Out of order nodes, too many nodes, values beyond the fixed-point range.
     for bad in [
         ScaleFactorTable::from_nodes(&[10.0, 0.0], &[0.0, 0.0], &[0.0, 0.0], 0.0),

@@ -1,11 +1,11 @@
 //! Output frames: round trip, CRC, no loss of angle when the queue is full.
 
 use gyro_sp::fog::scale_factor::{
-    FogTempWords, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable,
+    FogTempFlags, FogTempWords, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable,
 };
 use gyro_sp::fog::{ClosureOutput, Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
-use gyro_sp::rlg::RlgWords;
+use gyro_sp::rlg::{RlgFlags, RlgWords};
 use proptest::prelude::*;
 
 fn out(sagnac_phase: i64) -> ClosureOutput {
@@ -20,7 +20,7 @@ fn out(sagnac_phase: i64) -> ClosureOutput {
 fn round_trip_and_crc() {
     let f = Frame {
         seq: 7,
-        faults: 5,
+        faults: Faults::from_bits_retain(5),
         closures: 25,
         closure_counter: 1234,
         fog_angle: -99,
@@ -35,7 +35,7 @@ fn round_trip_and_crc() {
             t_mono_a_q8: -40 * 256,
             t_mono_b_q8: 85 * 256 + 3,
             t_case_q8: 20 * 256,
-            flags: 0b1010,
+            flags: RlgFlags::from_bits_retain(0b1010),
         },
         fog_angle_comp: -(1 << 50) + 17,
         fog_temp: FogTempWords {
@@ -43,7 +43,7 @@ fn round_trip_and_crc() {
             bias_q16_dph: 31_000,
             t_coil_q8: 48 * 256 + 7,
             t_sensor_q8: -40 * 256,
-            flags: 0b110,
+            flags: FogTempFlags::from_bits_retain(0b110),
         },
     };
     let b = f.encode();
@@ -102,7 +102,9 @@ fn restored_frame_loses_no_angle() {
         (comp as f64 - expected).abs() <= emitted.len() as f64 + 1.0,
         "{comp} vs {expected}"
     );
-    assert!(emitted.iter().any(|f| f.faults & Faults::QUEUE_FULL != 0));
+    assert!(emitted
+        .iter()
+        .any(|f| f.faults.contains(Faults::QUEUE_FULL)));
     for w in emitted.windows(2) {
         assert_eq!(
             w[1].seq,
@@ -133,7 +135,7 @@ proptest! {
             prop_assert!(out.codes_per_turn_q8 >= cfg.gain_loop.min_q8 && out.codes_per_turn_q8 <= cfg.gain_loop.max_q8);
             prop_assert!(dac.iter().all(|&d| u32::from(d) <= cfg.gain_loop.max_q8 >> 8));
             if adc.len() < cfg.n_samples || over_range {
-                prop_assert!(out.faults.has(gyro_sp::fog::Faults::ADC_SATURATION));
+                prop_assert!(out.faults.contains(gyro_sp::fog::Faults::ADC_SATURATION));
             }
         }
     }

@@ -1,7 +1,7 @@
 //! RLG core: pulse counting and thermal compensation against plain references.
 
 use gyro_sp::rlg::coeffs::{CoeffError, RECORD_LEN};
-use gyro_sp::rlg::thermal::{flags, ThermalConfig, STUCK_READS};
+use gyro_sp::rlg::thermal::{RlgFlags, ThermalConfig, STUCK_READS};
 use gyro_sp::rlg::{PulseCounter, Temperatures, ThermalCoeffs, ThermalComp};
 use proptest::prelude::*;
 
@@ -71,7 +71,7 @@ fn record_round_trip_and_refusals() {
         0,
         "refused coefficients compensate nothing"
     );
-    assert!(comp.flags() & flags::COEFFS_DEFAULT != 0);
+    assert!(comp.flags().contains(RlgFlags::COEFFS_DEFAULT));
 }
 
 /// The fixed-point compensation follows the model evaluated in f64 (with the
@@ -118,7 +118,7 @@ fn compensation_matches_float_model() {
         worst = worst.max((b - r).abs());
     }
     assert!(worst < 1e-4, "worst difference {worst} deg/h");
-    assert_eq!(comp.flags(), 0);
+    assert_eq!(comp.flags(), RlgFlags::empty());
 }
 
 /// A sensor that stops answering, reads nonsense or sticks raises its flag;
@@ -136,18 +136,18 @@ fn sensor_faults_flag_and_hold() {
     for k in 0..100 {
         b = comp.update(&cfg, &good(k));
     }
-    assert_eq!(comp.flags(), 0);
+    assert_eq!(comp.flags(), RlgFlags::empty());
     // Case sensor NACKs: flagged, bias continues from its last good value.
     let mut t = good(100);
     t.case_q8 = None;
     let held = comp.update(&cfg, &t);
-    assert!(comp.flags() & flags::SENSOR_CASE != 0);
+    assert!(comp.flags().contains(RlgFlags::SENSOR_CASE));
     assert!((held - b).abs() < 65_536 / 10, "bias jumped: {b} -> {held}");
     // Monoblock A reads nonsense (+300 degC): flagged.
     let mut t = good(101);
     t.mono_a_q8 = Some(300 * 256);
     comp.update(&cfg, &t);
-    assert!(comp.flags() & flags::SENSOR_A != 0);
+    assert!(comp.flags().contains(RlgFlags::SENSOR_A));
     // Monoblock B sticks.
     for k in 0..=STUCK_READS as i32 {
         comp.update(
@@ -158,10 +158,10 @@ fn sensor_faults_flag_and_hold() {
             },
         );
     }
-    assert!(comp.flags() & flags::SENSOR_B != 0);
+    assert!(comp.flags().contains(RlgFlags::SENSOR_B));
     // All good again.
     comp.update(&cfg, &good(300));
-    assert_eq!(comp.flags(), 0);
+    assert_eq!(comp.flags(), RlgFlags::empty());
 }
 
 /// The frame words: the compensated rate is counts/(K*T) - B_TC (formula, in

@@ -3,7 +3,7 @@
 
 use embedded_hal::i2c::ErrorKind;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gyro_sp::rlg::thermal::{flags, Temperatures, ThermalComp, ThermalConfig};
+use gyro_sp::rlg::thermal::{RlgFlags, Temperatures, ThermalComp, ThermalConfig};
 use gyro_sp::rlg::ThermalCoeffs;
 use tmp117::{Tmp117, Tmp117Error, NACK_ADDRESS};
 
@@ -98,7 +98,7 @@ fn nack_raises_flag_and_holds_value() {
             case_q8: k.read(&mut bus),
         };
         let bias = comp.update(&cfg, &t);
-        let bad = comp.flags() & flags::SENSOR_CASE != 0;
+        let bad = comp.flags().contains(RlgFlags::SENSOR_CASE);
         assert_eq!(bad, (10..15).contains(&i), "read {i}");
         let k4_term = 0.01 * if i < 15 { 30.0 } else { 31.0 };
         assert!(

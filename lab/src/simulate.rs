@@ -322,7 +322,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
                 (b_err, b_raw, b_n) = (0.0, 0.0, 0);
             }
         }
-        faults_seen |= r.out.faults.0;
+        faults_seen |= r.out.faults.bits();
         last_cpt = r.out.codes_per_turn_q8;
         if let Some(w) = writer.as_mut() {
             acc[0] += r.true_rate;
@@ -345,7 +345,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
                     rig.profile.accel_at(t_mid) / DEG,
                     acc[3] / n,
                     r.out.codes_per_turn_q8 as f64 / 256.0,
-                    r.out.faults.0
+                    r.out.faults.bits()
                 )?;
                 acc = [0.0; 4];
                 acc_n = 0;

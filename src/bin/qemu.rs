@@ -453,7 +453,7 @@ mod app {
         }
         l.rig.finish_step(out, truth);
         *l.counter += 1;
-        if out.faults.has(Faults::OPTICAL_POWER_LOW) && *l.counter == POWER_LOSS.start + 1 {
+        if out.faults.contains(Faults::OPTICAL_POWER_LOW) && *l.counter == POWER_LOSS.start + 1 {
             defmt::warn!("optical power low at step {}", *l.counter);
         }
         let to_frame_end = CLOSURES_PER_FRAME as u32 - *l.counter % CLOSURES_PER_FRAME as u32;

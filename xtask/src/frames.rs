@@ -3,10 +3,10 @@
 use anyhow::{Context, Result};
 use gyro_sim::profile::qemu_demo;
 use gyro_sim::ChamberParams;
-use gyro_sp::fog::scale_factor::flags as sf_flags;
+use gyro_sp::fog::scale_factor::FogTempFlags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
-use gyro_sp::rlg::thermal::flags as rlg_flags;
+use gyro_sp::rlg::RlgFlags;
 use std::io::Write;
 use std::path::Path;
 
@@ -141,7 +141,7 @@ pub fn write_rlg_run_file(r: &Report, path: &Path) -> Result<()> {
             g.t_mono_b_q8 as f64 / 256.0,
             g.t_case_q8 as f64 / 256.0,
             g.bias_q16_dph as f64 / 65_536.0,
-            g.flags
+            g.flags.bits()
         )?;
     }
     Ok(())
@@ -171,8 +171,8 @@ pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
             th.t_coil_q8 as f64 / 256.0,
             th.sf_corr_q32 as f64 / 4_294_967_296.0 * 1e6,
             th.bias_q16_dph as f64 / 65_536.0,
-            th.flags,
-            row.frame.faults,
+            th.flags.bits(),
+            row.frame.faults.bits(),
             row.frame.seq,
             row.frame.dc,
             row.frame.codes_per_turn_q8 as f64 / 256.0
@@ -231,7 +231,7 @@ pub fn segment_stats(r: &Report) -> Vec<SegmentStats> {
                     .rows
                     .iter()
                     .filter(|x| x.segment == s)
-                    .fold(0, |a, x| a | x.frame.faults),
+                    .fold(0, |a, x| a | x.frame.faults.bits()),
             }
         })
         .collect()
@@ -299,7 +299,10 @@ pub fn fog_temp_stats(r: &Report) -> FogTempStats {
     FogTempStats {
         first_coil_c: coil(r.rows.first()),
         last_coil_c: coil(r.rows.last()),
-        flags_seen: r.rows.iter().fold(0, |a, x| a | x.frame.fog_temp.flags),
+        flags_seen: r
+            .rows
+            .iter()
+            .fold(0, |a, x| a | x.frame.fog_temp.flags.bits()),
     }
 }
 
@@ -337,13 +340,13 @@ pub fn rlg_stats(r: &Report) -> RlgStats {
             last.t_mono_b_q8 as f64 / 256.0,
             last.t_case_q8 as f64 / 256.0,
         ],
-        flags_seen: r.rows.iter().fold(0, |a, x| a | x.frame.rlg.flags),
+        flags_seen: r.rows.iter().fold(0, |a, x| a | x.frame.rlg.flags.bits()),
         case_flagged: r
             .rows
             .iter()
-            .filter(|x| x.frame.rlg.flags & rlg_flags::SENSOR_CASE != 0)
+            .filter(|x| x.frame.rlg.flags.contains(RlgFlags::SENSOR_CASE))
             .count(),
-        case_cleared: last.flags & rlg_flags::SENSOR_CASE == 0,
+        case_cleared: !last.flags.contains(RlgFlags::SENSOR_CASE),
     }
 }
 
@@ -375,7 +378,7 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
             && !s.name.starts_with("ramp")
             && !s.name.contains("power loss")
     }) {
-        let ok = s.mean_dph.abs() < 1.0 && s.faults & Faults::OUT_OF_LOCK == 0;
+        let ok = s.mean_dph.abs() < 1.0 && s.faults & Faults::OUT_OF_LOCK.bits() == 0;
         v.push(("locked", ok, format!("{}: {:.4} deg/h", s.name, s.mean_dph)));
     }
     // The scale factor over temperature: each constant-rate segment's error
@@ -397,12 +400,15 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
         .iter()
         .skip(1)
         .filter(|x| {
-            x.frame.fog_temp.flags & (sf_flags::COIL_SENSOR | sf_flags::COEFFS_REFUSED) != 0
+            x.frame
+                .fog_temp
+                .flags
+                .intersects(FogTempFlags::COIL_SENSOR | FogTempFlags::COEFFS_REFUSED)
         })
         .count();
     v.push((
         "fog_coil_sensor_and_table",
-        sensor_flagged == 0 && th.last_coil_c > 60.0 && th.flags_seen & sf_flags::OUT_OF_RANGE != 0,
+        sensor_flagged == 0 && th.last_coil_c > 60.0 && th.flags_seen & FogTempFlags::OUT_OF_RANGE.bits() != 0,
         format!(
             "{sensor_flagged} frames flagged after the first; coil {:.2} -> {:.2} degC; flags seen {:#04x}",
             th.first_coil_c, th.last_coil_c, th.flags_seen
@@ -423,12 +429,12 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
     let fault_rows: Vec<&Row> = r
         .rows
         .iter()
-        .filter(|x| x.frame.faults & Faults::OPTICAL_POWER_LOW != 0)
+        .filter(|x| x.frame.faults.contains(Faults::OPTICAL_POWER_LOW))
         .collect();
     let cleared = r
         .rows
         .last()
-        .is_some_and(|x| x.frame.faults & Faults::OPTICAL_POWER_LOW == 0);
+        .is_some_and(|x| !x.frame.faults.contains(Faults::OPTICAL_POWER_LOW));
     v.push((
         "power_loss_flag_rises_and_clears",
         !fault_rows.is_empty() && cleared,
@@ -453,7 +459,7 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
     ));
     v.push((
         "rlg_coefficients_loaded",
-        g.flags_seen & rlg_flags::COEFFS_DEFAULT == 0 && g.bias_dph != 0.0,
+        g.flags_seen & RlgFlags::COEFFS_DEFAULT.bits() == 0 && g.bias_dph != 0.0,
         format!(
             "B_TC {:.4} deg/h, flags seen {:#04x}",
             g.bias_dph, g.flags_seen

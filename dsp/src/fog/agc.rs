@@ -6,7 +6,7 @@
 //! docs/fog.md, "AGC and the DC moment"), which would otherwise lower the
 //! loop gain under dynamics.
 
-use super::config::FogParams;
+use crate::phase::RAD_PER_PHASE_LSB;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
 
@@ -31,17 +31,24 @@ pub struct AgcConfig {
 }
 
 impl AgcConfig {
-    /// From the nominal and dark detector levels per sample, the kept
-    /// samples per half period, the depth and the half periods per closure.
-    pub fn new(p: &FogParams, n_half: usize) -> Self {
-        let kept = p.samples_per_half.saturating_sub(p.skip_samples) as f64;
-        let h0_nominal = p.nominal_dc_lsb * kept;
+    /// From the detector's DC at the operating point and its dark level
+    /// (ADC LSB per sample, above dark and absolute), the kept samples per
+    /// half period, the depth phi0 and the half periods per closure.
+    pub fn new(
+        nominal_dc_lsb: f64,
+        dark_lsb: f64,
+        kept_per_half: usize,
+        phi0_rad: f64,
+        n_half: usize,
+    ) -> Self {
+        let kept = kept_per_half as f64;
+        let h0_nominal = nominal_dc_lsb * kept;
         let nf = n_half as f64;
-        let moment = -(1.0 / p.phi0_rad.tan()) / (2.0 * nf) * crate::RAD_PER_PHASE_LSB;
+        let moment = -(1.0 / phi0_rad.tan()) / (2.0 * nf) * RAD_PER_PHASE_LSB;
         Self {
             h0_nominal: h0_nominal.round() as u32,
             h0_min: (h0_nominal * 0.25).round().max(2.0) as u32,
-            dark_half: (p.dark_lsb.max(0.0) * kept).round() as u32,
+            dark_half: (dark_lsb.max(0.0) * kept).round() as u32,
             spread_q8: (256.0 * 2.0 * (nf * nf - 1.0) / (3.0 * nf * nf)).round() as i32,
             moment_q60: (moment * (1u64 << 60) as f64)
                 .round()
@@ -62,6 +69,10 @@ impl AgcConfig {
 /// a first-order term in the in-closure residual slope (proportional to
 /// eps), so a fast AGC would modulate the loop gain at the vibration
 /// frequency and rectify a second eps^2 drift.
+///
+/// Its output, the normaliser, is read before the closure's residual
+/// exists ([`Agc::normaliser`], no state change); the closure then feeds its
+/// own DC and spread back through the one update ([`Agc::update`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Agc {
     dc_q12: u32,
@@ -83,6 +94,16 @@ pub struct Spread {
     pub residual: i32,
 }
 
+/// What one closure tells the AGC.
+#[derive(Clone, Copy, Debug)]
+pub enum AgcInput {
+    /// Optical power low: the filter restarts from the next lit closure.
+    Dark,
+    /// A lit closure with true levels (not clipped): its DC of one half
+    /// period (dark removed, ADC LSB) and its residual spread.
+    Lit { dc_half: u32, spread: Spread },
+}
+
 impl Agc {
     pub fn new(cfg: &AgcConfig) -> Self {
         Self {
@@ -91,47 +112,43 @@ impl Agc {
         }
     }
 
-    /// No light: the AGC restarts from the next good closure.
-    pub fn light_lost(&mut self) {
-        self.valid = false;
-    }
-
-    /// The normalising DC for this closure: returns 2^32/H (H not below
-    /// h0_min, the error scaling's range) and whether the filter was just
-    /// seeded from this closure's DC (not while the ADC clips).
+    /// The normalising DC for the closure whose DC is `dc_half`: 2^32/H (H
+    /// not below h0_min, the error scaling's range), H the filtered DC, or
+    /// this closure's own until the filter holds a measured value.
     #[inline(always)]
-    pub fn normaliser(
-        &mut self,
-        cfg: &AgcConfig,
-        dc_half: u32,
-        adc_over_range: bool,
-    ) -> (u32, bool) {
-        let seeding = !self.valid;
-        if seeding {
-            self.dc_q12 = dc_half.min(MAX_HALF_SUM) << 12;
-            self.valid = !adc_over_range;
-        }
-        let h = (self.dc_q12 >> 12).max(cfg.h0_min).max(2);
-        (u32::MAX / h, seeding)
+    pub fn normaliser(&self, cfg: &AgcConfig, dc_half: u32) -> u32 {
+        let dc = if self.valid {
+            self.dc_q12 >> 12
+        } else {
+            dc_half.min(MAX_HALF_SUM)
+        };
+        u32::MAX / dc.max(cfg.h0_min).max(2)
     }
 
-    /// Advances the filter with this closure's DC less its moment excess
-    /// (re-seeds with that flat value on the seeding closure).
+    /// Advances the filter with a lit closure's DC less its moment excess
+    /// (the first after start or darkness seeds it with that flat value),
+    /// or restarts it after darkness. Clipped closures are not fed: their
+    /// levels are not true.
     /// |diff| < 2^27, |slope * spread| < 2^29, |sum| < 2^27, |residual| <
     /// 2^31: |m| < 2^58 and its high word below 2^26 (dropping the low word
     /// costs under 1e-4 of the DC).
     #[inline(always)]
-    pub fn update(&mut self, cfg: &AgcConfig, dc_half: u32, s: Spread, seeding: bool) {
+    pub fn update(&mut self, cfg: &AgcConfig, input: AgcInput) {
+        let AgcInput::Lit { dc_half, spread: s } = input else {
+            self.valid = false;
+            return;
+        };
         let m = s.diff as i64 * s.slope.wrapping_mul(cfg.spread_q8) as i64
             + s.neg_sum as i64 * s.residual as i64;
         let excess = ((m >> 32) * cfg.moment_q60 as i64) >> 28;
         let dc = dc_half.min(MAX_HALF_SUM) as i32;
         let flat = (dc - excess as i32).clamp(0, MAX_HALF_SUM as i32) as u32;
-        self.dc_q12 = if seeding {
-            flat << 12
-        } else {
+        self.dc_q12 = if self.valid {
             self.dc_q12 - (self.dc_q12 >> 12) + flat
+        } else {
+            flat << 12
         };
+        self.valid = true;
     }
 
     /// Filtered DC of one half period, ADC LSB.
@@ -143,26 +160,34 @@ impl Agc {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use core::f64::consts::PI;
+
+    /// The reference instrument: 8 000 LSB per sample above a 1 024 dark
+    /// level, 3 kept samples per half period, 3*pi/4, 16 half periods.
+    fn reference() -> AgcConfig {
+        AgcConfig::new(8_000.0, 1_024.0, 3, 0.75 * PI, 16)
+    }
+
+    const FLAT: Spread = Spread {
+        diff: 0,
+        slope: 0,
+        neg_sum: 0,
+        residual: 0,
+    };
+
+    fn lit(dc_half: u32, spread: Spread) -> AgcInput {
+        AgcInput::Lit { dc_half, spread }
+    }
 
     /// A DC step settles with the filter's time constant: after 4096
     /// closures 1 - 1/e of the way (first-order, to 1e-3).
     #[test]
     fn filter_time_constant_is_4096_closures() {
-        let p = FogParams::default();
-        let cfg = AgcConfig::new(&p, 16);
+        let cfg = reference();
         let mut agc = Agc::new(&cfg);
-        let flat = Spread {
-            diff: 0,
-            slope: 0,
-            neg_sum: 0,
-            residual: 0,
-        };
-        let (_, seeding) = agc.normaliser(&cfg, 10_000, false);
-        agc.update(&cfg, 10_000, flat, seeding);
+        agc.update(&cfg, lit(10_000, FLAT));
         for _ in 0..4096 {
-            let (_, seeding) = agc.normaliser(&cfg, 20_000, false);
-            assert!(!seeding);
-            agc.update(&cfg, 20_000, flat, seeding);
+            agc.update(&cfg, lit(20_000, FLAT));
         }
         let got = (agc.dc() as f64 - 10_000.0) / 10_000.0;
         let expect = 1.0 - (-1.0f64).exp();
@@ -173,9 +198,8 @@ mod tests {
     /// raises the DC (cos(phi0) < 0), so the excess removed is positive.
     #[test]
     fn moment_removes_the_spread_excess() {
-        let p = FogParams::default();
-        let n = 16;
-        let cfg = AgcConfig::new(&p, n);
+        let (phi0, n) = (0.75 * PI, 16);
+        let cfg = AgcConfig::new(8_000.0, 1_024.0, 3, phi0, n);
         let s = Spread {
             diff: 0,
             slope: 0,
@@ -183,9 +207,9 @@ mod tests {
             residual: 1 << 26,
         };
         let mut agc = Agc::new(&cfg);
-        agc.update(&cfg, 50_000, s, true);
+        agc.update(&cfg, lit(50_000, s));
         let m = (s.neg_sum as f64) * (s.residual as f64);
-        let excess = m * -(1.0 / p.phi0_rad.tan()) / (2.0 * n as f64) * crate::RAD_PER_PHASE_LSB;
+        let excess = m * -(1.0 / phi0.tan()) / (2.0 * n as f64) * RAD_PER_PHASE_LSB;
         let removed = 50_000.0 - agc.dc() as f64;
         assert!(excess > 0.0);
         assert!(
@@ -194,17 +218,34 @@ mod tests {
         );
     }
 
+    /// Until a lit closure is fed (at start, after clipped closures, after
+    /// darkness) the normaliser is the closure's own DC; then the filter's.
     #[test]
     fn seeds_on_first_good_closure_and_after_light_loss() {
-        let cfg = AgcConfig::new(&FogParams::default(), 16);
+        let cfg = reference();
         let mut agc = Agc::new(&cfg);
-        assert!(agc.normaliser(&cfg, 30_000, true).1);
-        // Seeded while clipping: not valid, seeds again.
-        assert!(agc.normaliser(&cfg, 30_000, false).1);
-        assert!(!agc.normaliser(&cfg, 30_000, false).1);
-        agc.light_lost();
-        let (recip, seeding) = agc.normaliser(&cfg, 40_000, false);
-        assert!(seeding);
-        assert_eq!(recip, u32::MAX / 40_000);
+        assert_eq!(agc.normaliser(&cfg, 30_000), u32::MAX / 30_000);
+        // A clipped closure is not fed: the next still normalises by its own.
+        assert_eq!(agc.normaliser(&cfg, 35_000), u32::MAX / 35_000);
+        agc.update(&cfg, lit(30_000, FLAT));
+        assert_eq!(agc.normaliser(&cfg, 99_000), u32::MAX / 30_000);
+        agc.update(&cfg, AgcInput::Dark);
+        assert_eq!(agc.normaliser(&cfg, 40_000), u32::MAX / 40_000);
+        // Never below the power-low threshold: the error scaling's range.
+        assert_eq!(agc.normaliser(&cfg, 10), u32::MAX / cfg.h0_min);
+    }
+
+    /// The derived constants against their formulas.
+    #[test]
+    fn config_follows_the_detector_levels() {
+        let cfg = reference();
+        assert_eq!(cfg.h0_nominal, 24_000);
+        assert_eq!(cfg.h0_min, 6_000);
+        assert_eq!(cfg.dark_half, 3_072);
+        // 2^8 * 2(n^2 - 1)/(3 n^2) at n = 16.
+        assert_eq!(
+            cfg.spread_q8,
+            (256.0 * 2.0 * 255.0 / 768.0f64).round() as i32
+        );
     }
 }

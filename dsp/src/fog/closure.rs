@@ -7,16 +7,17 @@
 //! [`FogConfig`] is passed in; all mutable state lives in [`FogLoop`], one
 //! field per block.
 
-use super::agc::{Agc, Spread};
+use super::agc::{Agc, AgcInput, Spread};
 use super::config::FogConfig;
 use super::demod::demodulate;
 use super::dither::Dither;
 use super::faults::Faults;
-use super::gain_loop;
+use super::gain_loop::GainLoop;
+use super::layout::Kernel;
 use super::lock::LockDetector;
 use super::modulator::{Modulator, Resets};
-use super::shr_saturate;
 use super::vibration::VibrationCorrection;
+use crate::fixed::shr_saturate;
 
 /// What one closure produces.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -36,31 +37,6 @@ pub struct ClosureOutput {
     pub faults: Faults,
 }
 
-/// The compiled copies of the closure: the reference instruments' layouts
-/// (16 or 32 half periods of 4 samples, 1 skipped, no DAC latency) with the
-/// sizes as constants (divisions become shifts, loops unroll), and any
-/// layout with runtime sizes, without or with one closure of DAC latency.
-/// Chosen once at configuration; [`FogLoop::process`] is the one place that
-/// maps it to sizes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kernel {
-    Half16,
-    Half32,
-    Any,
-    AnyLatency1,
-}
-
-impl Kernel {
-    pub fn for_layout(n_half: usize, samples_per_half: usize, skip: usize, latency: u32) -> Self {
-        match (n_half, samples_per_half, skip, latency) {
-            (16, 4, 1, 0) => Kernel::Half16,
-            (32, 4, 1, 0) => Kernel::Half32,
-            (_, _, _, 0) => Kernel::Any,
-            _ => Kernel::AnyLatency1,
-        }
-    }
-}
-
 /// What the closure needs to know about DAC words when their samples come back.
 #[derive(Clone, Copy, Debug, Default)]
 struct Written {
@@ -78,8 +54,8 @@ struct Written {
 pub struct FogLoop {
     /// Integrator: the feedback phase last written, phase LSB, unwrapped.
     feedback: i64,
-    /// Digital gain from the 2*pi loop, DAC codes per turn in Q8.
-    codes_per_turn_q8: u32,
+    /// The 2*pi loop: the digital gain, DAC codes per turn.
+    gain_loop: GainLoop,
     agc: Agc,
     modulator: Modulator,
     /// The DAC words the next call's samples were taken with.
@@ -114,7 +90,7 @@ impl FogLoop {
     pub fn new(cfg: &FogConfig) -> Self {
         Self {
             feedback: 0,
-            codes_per_turn_q8: cfg.gain_loop.nominal_q8,
+            gain_loop: GainLoop::new(&cfg.gain_loop),
             agc: Agc::new(&cfg.agc),
             modulator: Modulator::default(),
             applied: Written::default(),
@@ -149,11 +125,12 @@ impl FogLoop {
         cfg: &FogConfig,
         dac: &mut [u16],
     ) {
-        let (r, dither_gain_m1_q32) = self.dither.next(&cfg.dither);
+        let depth = self.dither.update(&cfg.dither);
+        let dither_gain_m1_q32 = depth.gain_m1_q32;
         let resets = self.modulator.write_closure::<H>(
             self.feedback as u32,
-            cfg.phi0.wrapping_add(r),
-            self.codes_per_turn_q8,
+            cfg.phi0.wrapping_add(depth.offset),
+            self.gain_loop.codes_per_turn_q8(),
             dac,
         );
         if LATENCY == 0 {
@@ -233,9 +210,9 @@ impl FogLoop {
             // Safe path: the error means nothing without light. Hold the
             // feedback and the gain; the output repeats the last good phase
             // (flagged); the AGC restarts when the light comes back.
-            self.agc.light_lost();
+            self.agc.update(&cfg.agc, AgcInput::Dark);
         } else {
-            let (recip_h, seeding) = self.agc.normaliser(&cfg.agc, dc_half, adc_over_range);
+            let recip_h = self.agc.normaliser(&cfg.agc, dc_half);
             // Residual per unit sum(sign*h), phase LSB in Q16: per_count/H,
             // times the dither's factor for this closure's depth (1 -
             // r*cot(phi0)): not undone, the dither's slope change would
@@ -278,16 +255,15 @@ impl FogLoop {
             };
             self.feedback = clamp_feedback(self.feedback + correction);
             if !adc_over_range {
-                if residual.unsigned_abs() <= cfg.gain_loop.hold_limit {
-                    let err = gain_loop::reset_error(&sums, &self.applied.resets, n_half as u32);
-                    self.codes_per_turn_q8 =
-                        gain_loop::update(self.codes_per_turn_q8, err, &cfg.gain_loop, recip_h);
-                }
-                if cfg.vibration.enabled {
-                    bias = self
-                        .vibration
-                        .update(slope_q3, residual, cfg.vibration.coeff);
-                }
+                self.gain_loop.update(
+                    &cfg.gain_loop,
+                    &sums,
+                    &self.applied.resets,
+                    n_half as u32,
+                    residual,
+                    recip_h,
+                );
+                bias = self.vibration.update(&cfg.vibration, slope_q3, residual);
                 let spread = Spread {
                     diff,
                     // The slope in 2^8 LSB, saturated at +-2^20.
@@ -295,7 +271,7 @@ impl FogLoop {
                     neg_sum,
                     residual,
                 };
-                self.agc.update(&cfg.agc, dc_half, spread, seeding);
+                self.agc.update(&cfg.agc, AgcInput::Lit { dc_half, spread });
             }
             if let Some(lost) = self.lock.update(&cfg.lock, residual) {
                 self.faults.set(Faults::OUT_OF_LOCK, lost);
@@ -312,7 +288,7 @@ impl FogLoop {
             sagnac_phase: measured,
             sagnac_phase_corrected: measured - bias as i64,
             residual,
-            codes_per_turn_q8: self.codes_per_turn_q8,
+            codes_per_turn_q8: self.gain_loop.codes_per_turn_q8(),
             dc,
             faults: self.faults,
         }

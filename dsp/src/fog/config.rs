@@ -3,13 +3,12 @@
 //! reads it.
 
 use super::agc::AgcConfig;
-use super::closure::Kernel;
 use super::dither::DitherConfig;
 use super::gain_loop::GainLoopConfig;
+use super::layout::{Kernel, MAX_HALF, MAX_SAMPLES_PER_HALF};
 use super::lock::LockConfig;
 use super::vibration::VibrationConfig;
-use super::{MAX_HALF, MAX_SAMPLES_PER_HALF};
-use crate::{phase_from_rad, Phase};
+use crate::phase::{phase_from_rad, Phase, PHASE_LSB_PER_RAD, RAD_PER_PHASE_LSB};
 use core::f64::consts::{PI, TAU};
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
@@ -200,9 +199,20 @@ impl FogConfig {
             return Err(ConfigError::DacRange);
         }
         let k_sagnac_s = TAU * p.fiber_length_m * p.coil_diameter_m / (p.wavelength_m * C_LIGHT);
-        let agc = AgcConfig::new(&p, n_half);
-        let dither = DitherConfig::new(&p);
-        let vibration = VibrationConfig::new(&p, n_half)?;
+        let kept_per_half = p.samples_per_half - p.skip_samples;
+        let agc = AgcConfig::new(
+            p.nominal_dc_lsb,
+            p.dark_lsb,
+            kept_per_half,
+            p.phi0_rad,
+            n_half,
+        );
+        let dither =
+            DitherConfig::new(p.dither_adc_codes, p.adc_bits, p.nominal_dc_lsb, p.phi0_rad);
+        let vibration = VibrationConfig::new(p.vibration_correction, p.phi0_rad, n_half)
+            .ok_or(ConfigError::VibrationCoeff)?;
+        let gain_loop =
+            GainLoopConfig::new(p.gain_loop_gain, p.dac_codes_per_turn, p.phi0_rad, n_half);
 
         // Residual per normalised demodulator count. With depth phi0 + r (the
         // dither) the error slope is A*sin(phi0 + r), which the closure scales
@@ -223,9 +233,8 @@ impl FogConfig {
             (1.0, 0.0)
         };
         let slope_mean = sinc - cot_phi0 * cot_phi0 * r_sin;
-        let lsb_per_rad = 4_294_967_296.0 / TAU;
-        let per_count =
-            cot_half * lsb_per_rad / n_half as f64 * (1.0 + c * sinc) / ((1.0 + c) * slope_mean);
+        let per_count = cot_half * PHASE_LSB_PER_RAD / n_half as f64 * (1.0 + c * sinc)
+            / ((1.0 + c) * slope_mean);
         // The closure scales the error by per_count * (2^32/H) / 2^16 with H
         // >= h0_min; below 2^31 its products with the closure's sums (below
         // 2^27) are single 32x32 multiplies. That needs the operating point's
@@ -251,9 +260,9 @@ impl FogConfig {
             loop_gain_q16: (p.loop_gain * 65_536.0).round() as i32,
             agc,
             dither,
-            gain_loop: GainLoopConfig::new(&p, n_half),
+            gain_loop,
             vibration,
-            lock: LockConfig::new(),
+            lock: LockConfig::new(p.closure_hz),
         })
     }
 
@@ -264,7 +273,7 @@ impl FogConfig {
 
     /// Rate (rad/s) of one phase LSB of the feedback phase.
     pub fn rad_s_per_phase_lsb(&self) -> f64 {
-        crate::RAD_PER_PHASE_LSB / self.k_sagnac_s
+        RAD_PER_PHASE_LSB / self.k_sagnac_s
     }
 
     /// Angle (rad) of one unit of the angle-increment word (one closure LSB held

@@ -4,13 +4,9 @@
 //! dither"). A closure of depth phi0 + r has the error slope sin(phi0 + r);
 //! the closure undoes that to first order with the gain factor 1 - r*cot(phi0).
 
-use super::config::FogParams;
-use crate::Phase;
+use crate::phase::{Phase, PHASE_LSB_PER_RAD as LSB_PER_RAD};
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
-
-/// Phase LSB per rad.
-const LSB_PER_RAD: f64 = 4_294_967_296.0 / core::f64::consts::TAU;
 
 /// The dither's width and the gain correction that goes with it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,17 +21,19 @@ pub struct DitherConfig {
 }
 
 impl DitherConfig {
-    /// `dither_adc_codes` of half-period level at the operating point, at
-    /// the level's slope A*sin(phi0) per rad (A from the nominal DC), rounded
-    /// to a power of two and narrowed until |r*cot(phi0)| <= 1/8.
-    pub fn new(p: &FogParams) -> Self {
-        if p.dither_adc_codes <= 0.0 || p.dither_adc_codes.is_nan() {
+    /// `adc_codes` of half-period level at the operating point (codes of an
+    /// `adc_bits` ADC, left-aligned in 16 bits), at the level's slope
+    /// A*sin(phi0) per rad (A from the nominal DC per sample above dark,
+    /// `nominal_dc_lsb`), rounded to a power of two and narrowed until
+    /// |r*cot(phi0)| <= 1/8.
+    pub fn new(adc_codes: f64, adc_bits: u32, nominal_dc_lsb: f64, phi0_rad: f64) -> Self {
+        if adc_codes <= 0.0 || adc_codes.is_nan() {
             return Self { bits: 0, gain: 0 };
         }
-        let cot_phi0 = 1.0 / p.phi0_rad.tan();
-        let amplitude = p.nominal_dc_lsb / (1.0 + p.phi0_rad.cos());
-        let code_lsb = (1u32 << (16 - p.adc_bits.clamp(1, 16))) as f64;
-        let half_width_rad = p.dither_adc_codes * code_lsb / (amplitude * p.phi0_rad.sin());
+        let cot_phi0 = 1.0 / phi0_rad.tan();
+        let amplitude = nominal_dc_lsb / (1.0 + phi0_rad.cos());
+        let code_lsb = (1u32 << (16 - adc_bits.clamp(1, 16))) as f64;
+        let half_width_rad = adc_codes * code_lsb / (amplitude * phi0_rad.sin());
         let mut bits = ((2.0 * half_width_rad * LSB_PER_RAD).log2().round() as u32).clamp(1, 28);
         while bits > 1 && (1u64 << (bits - 1)) as f64 / LSB_PER_RAD * cot_phi0.abs() > 0.125 {
             bits -= 1;
@@ -69,11 +67,20 @@ impl Default for Dither {
     }
 }
 
+/// One closure's depth offset and the gain factor that undoes its slope change.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DepthStep {
+    /// Depth offset r, phase LSB (wrapping: negative offsets are high values).
+    pub offset: Phase,
+    /// 1 - r*cot(phi0) less one, Q32.
+    pub gain_m1_q32: i32,
+}
+
 impl Dither {
-    /// The next closure's depth offset r (phase LSB) and its gain factor
-    /// less one, Q32 (the dropped low bits of x are under 2^-bits of it).
+    /// The next closure's depth offset r and its gain factor less one
+    /// (the dropped low bits of x are under 2^-bits of it).
     #[inline(always)]
-    pub fn next(&mut self, cfg: &DitherConfig) -> (Phase, i32) {
+    pub fn update(&mut self, cfg: &DitherConfig) -> DepthStep {
         let mut x = self.state;
         x ^= x << 13;
         x ^= x >> 17;
@@ -82,7 +89,10 @@ impl Dither {
         // bits = 0: off.
         let r = (x as i32).checked_shr(32 - cfg.bits).unwrap_or(0);
         let gain_m1_q32 = ((x as i32 as i64 * cfg.gain as i64) >> 32) as i32;
-        (r as Phase, gain_m1_q32)
+        DepthStep {
+            offset: r as Phase,
+            gain_m1_q32,
+        }
     }
 }
 
@@ -94,16 +104,19 @@ mod tests {
     /// matches 1 - r*cot(phi0) to the dropped bits.
     #[test]
     fn offsets_and_gain_follow_the_width() {
-        let p = FogParams::default();
-        let cfg = DitherConfig::new(&p);
+        let phi0 = 0.75 * core::f64::consts::PI;
+        let cfg = DitherConfig::new(60.0, 12, 8_000.0, phi0);
         assert!(cfg.bits > 0 && cfg.bits <= 28);
-        let cot = 1.0 / p.phi0_rad.tan();
+        let cot = 1.0 / phi0.tan();
         assert!(cfg.half_width_rad() * cot.abs() <= 0.125);
         let mut d = Dither::default();
         let half = 1i64 << (cfg.bits - 1);
         let (mut sum, n) = (0f64, 100_000);
         for _ in 0..n {
-            let (r, g) = d.next(&cfg);
+            let DepthStep {
+                offset: r,
+                gain_m1_q32: g,
+            } = d.update(&cfg);
             let r = r as i32 as i64;
             assert!((-half..half).contains(&r));
             sum += r as f64;
@@ -121,12 +134,8 @@ mod tests {
 
     #[test]
     fn zero_codes_turn_it_off() {
-        let p = FogParams {
-            dither_adc_codes: 0.0,
-            ..FogParams::default()
-        };
-        let cfg = DitherConfig::new(&p);
+        let cfg = DitherConfig::new(0.0, 12, 8_000.0, 0.75 * core::f64::consts::PI);
         assert_eq!((cfg.bits, cfg.gain), (0, 0));
-        assert_eq!(Dither::default().next(&cfg), (0, 0));
+        assert_eq!(Dither::default().update(&cfg), DepthStep::default());
     }
 }

@@ -6,8 +6,10 @@
 //! `sum_j w_j*sign_j*(h_j - H)` over the reset half periods is proportional to +g;
 //! integrating it against the digital gain (codes per turn) keeps a reset exactly 2*pi.
 
-use super::config::FogParams;
-use crate::{phase_from_rad, Phase};
+use super::demod::DemodSums;
+use super::modulator::Resets;
+use crate::fixed::shr_saturate;
+use crate::phase::{phase_from_rad, Phase};
 use core::f64::consts::TAU;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
@@ -31,24 +33,66 @@ pub struct GainLoopConfig {
 }
 
 impl GainLoopConfig {
-    /// `gain_loop_gain` of a measured gain error corrected per reset, at
-    /// the error's scale cot(phi0/2)/(2*pi) per unit, for `n_half` half periods.
-    pub fn new(p: &FogParams, n_half: usize) -> Self {
-        let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
-        let gain = p.gain_loop_gain * p.dac_codes_per_turn as f64 * 256.0 * cot_half / TAU * 16.0
-            / n_half as f64;
+    /// `loop_gain` of a measured gain error corrected per reset, at the
+    /// error's scale cot(phi0/2)/(2*pi) per unit, for `n_half` half periods,
+    /// around `dac_codes_per_turn` (2*pi at nominal V_pi).
+    pub fn new(loop_gain: f64, dac_codes_per_turn: u32, phi0_rad: f64, n_half: usize) -> Self {
+        let cot_half = 1.0 / (phi0_rad / 2.0).tan();
+        let gain =
+            loop_gain * dac_codes_per_turn as f64 * 256.0 * cot_half / TAU * 16.0 / n_half as f64;
         Self {
             gain: gain.round().clamp(0.0, ((1 << 27) - 1) as f64) as i32,
-            nominal_q8: p.dac_codes_per_turn << 8,
-            min_q8: ((p.dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
-            max_q8: ((p.dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
-            hold_limit: phase_from_rad(0.1),
+            nominal_q8: dac_codes_per_turn << 8,
+            min_q8: ((dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
+            max_q8: ((dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
+            hold_limit: phase_from_rad(HOLD_LIMIT_RAD),
         }
     }
 }
 
-use super::demod::DemodSums;
-use super::modulator::Resets;
+/// Residual beyond which the loop holds, rad.
+pub const HOLD_LIMIT_RAD: f64 = 0.1;
+
+/// State: the digital gain, DAC codes per turn in Q8.
+#[derive(Clone, Copy, Debug)]
+pub struct GainLoop {
+    codes_per_turn_q8: u32,
+}
+
+impl GainLoop {
+    pub fn new(cfg: &GainLoopConfig) -> Self {
+        Self {
+            codes_per_turn_q8: cfg.nominal_q8,
+        }
+    }
+
+    /// The digital gain in use, DAC codes per turn, Q8.
+    #[inline(always)]
+    pub fn codes_per_turn_q8(&self) -> u32 {
+        self.codes_per_turn_q8
+    }
+
+    /// One closure with true levels: its demodulated sums, the resets of
+    /// the words they were taken with, its mean residual (phase LSB) and
+    /// the AGC's 2^32/H. Holds beyond [`GainLoopConfig::hold_limit`];
+    /// otherwise trims the gain by the resets' phase error. Returns the gain.
+    #[inline(always)]
+    pub(crate) fn update(
+        &mut self,
+        cfg: &GainLoopConfig,
+        sums: &DemodSums,
+        resets: &Resets,
+        n_half: u32,
+        residual: i32,
+        recip_h: u32,
+    ) -> u32 {
+        if residual.unsigned_abs() <= cfg.hold_limit {
+            let err = reset_error(sums, resets, n_half);
+            self.codes_per_turn_q8 = trim(self.codes_per_turn_q8, err, cfg, recip_h);
+        }
+        self.codes_per_turn_q8
+    }
+}
 
 /// Returns n * (sum_j c_j * h_j) over the closure (n = `n_half`), exact: no
 /// division, so no rounding that correlates with the resets. The weights are
@@ -71,7 +115,7 @@ use super::modulator::Resets;
 /// 4*n^2*h_max, under 2^31 for the layouts config accepts (n^2 * kept <
 /// 8192); the arithmetic wraps on purpose only beyond that.
 #[inline(always)]
-pub(crate) fn reset_error(sums: &DemodSums, resets: &Resets, n_half: u32) -> i32 {
+fn reset_error(sums: &DemodSums, resets: &Resets, n_half: u32) -> i32 {
     let pairs = (n_half / 2) as i32;
     let n = n_half.max(4) as i32;
     let (neg_p, neg_m) = (resets.plus_negative, resets.minus_negative);
@@ -185,10 +229,10 @@ static BYTE_MOMENT: [u16; 256] = {
 /// `recip_h`: 2^32 / H (H = DC of one half period's kept samples, at least
 /// 2, so below 2^31).
 #[inline(always)]
-pub(crate) fn update(codes_per_turn_q8: u32, err: i32, cfg: &GainLoopConfig, recip_h: u32) -> u32 {
+fn trim(codes_per_turn_q8: u32, err: i32, cfg: &GainLoopConfig, recip_h: u32) -> u32 {
     // err/H in Q20, saturated at |err/H| < 2^8 (n/16 times a 25 % gain error,
     // the clamp's end): only a wild start converges slower.
-    let e_q20 = super::shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
+    let e_q20 = shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
     // Q20 x Q4 gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
     let delta = ((e_q20 * cfg.gain as i64 + (1 << 23)) >> 24) as i32;
     // The gain, min, max < 2^24 (config); the subtraction saturates.
@@ -222,5 +266,41 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Beyond the hold limit the gain does not move, whatever the error;
+    /// inside it a large error drives it to the clamp and no further.
+    #[test]
+    fn holds_under_dynamics_and_saturates_at_the_clamp() {
+        let cfg = GainLoopConfig::new(0.05, 49_152, 0.75 * core::f64::consts::PI, 16);
+        let resets = Resets {
+            plus: 0xFF,
+            minus: 0,
+            plus_negative: false,
+            minus_negative: false,
+        };
+        let sums = DemodSums {
+            first: 0,
+            second: 0,
+            dc: 16 * 30_000,
+            carried: 8 * 31_000,
+        };
+        let recip_h = u32::MAX / 30_000;
+        let mut g = GainLoop::new(&cfg);
+        let beyond = cfg.hold_limit as i32 + 1;
+        for _ in 0..1000 {
+            assert_eq!(
+                g.update(&cfg, &sums, &resets, 16, beyond, recip_h),
+                cfg.nominal_q8
+            );
+        }
+        let err = reset_error(&sums, &resets, 16);
+        assert_ne!(err, 0);
+        let mut last = cfg.nominal_q8;
+        for _ in 0..100_000 {
+            last = g.update(&cfg, &sums, &resets, 16, 0, recip_h);
+            assert!((cfg.min_q8..=cfg.max_q8).contains(&last));
+        }
+        assert!(last == cfg.min_q8 || last == cfg.max_q8, "{last}");
     }
 }

@@ -14,7 +14,7 @@
 //! detector leaves the loop a dead zone of half an ADC LSB (about 4e-4 rad with a
 //! 12-bit ADC).
 
-use crate::Phase;
+use crate::phase::Phase;
 
 /// Where the drive phase carried out of the u32 (wrapped) in one closure.
 /// Bit i (counted from bit `pairs - 1` down to 0) is pair i's plus or minus

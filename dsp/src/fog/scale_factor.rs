@@ -18,14 +18,15 @@
 //! - angles: the frame's i64 angle LSB (2*pi/2^32 rad * tau / K_s).
 //!
 //! Faults: a bad coil sensor ([`crate::sensor`]) holds the last good
-//! temperature (the lead decays to 0) and sets [`flags::COIL_SENSOR`]; a
+//! temperature (the lead decays to 0) and sets [`FogTempFlags::COIL_SENSOR`]; a
 //! coil temperature outside the calibrated range uses the end node and sets
-//! [`flags::OUT_OF_RANGE`]; a refused record runs with no compensation and
-//! sets [`flags::COEFFS_REFUSED`]. Before the first good read the table is
+//! [`FogTempFlags::OUT_OF_RANGE`]; a refused record runs with no compensation and
+//! sets [`FogTempFlags::COEFFS_REFUSED`]. Before the first good read the table is
 //! read at the middle of the calibrated range (flagged as a bad sensor).
 
 use super::config::FogConfig;
 use crate::derivative::{Derivative, DerivativeConfig};
+use crate::phase::RAD_PER_PHASE_LSB;
 use crate::sensor::SensorHold;
 pub use gyro_coeffs::fog_scale_factor::ScaleFactorTable;
 use gyro_coeffs::fog_scale_factor::MAX_NODES;
@@ -37,15 +38,18 @@ use num_traits::float::Float;
 /// at 1 Hz and a 30 s lag the coil estimate carries about 0.025 degC.
 pub const LEAD_FILTER_TAU_S: f64 = 60.0;
 
-/// Fault bits of the FOG temperature compensation (frame byte).
-pub mod flags {
-    /// The coil sensor is bad (failed, implausible or stuck): last good
-    /// temperature held.
-    pub const COIL_SENSOR: u8 = 1 << 0;
-    /// Coil temperature outside the calibrated range: end node used.
-    pub const OUT_OF_RANGE: u8 = 1 << 1;
-    /// The stored table was refused: no compensation.
-    pub const COEFFS_REFUSED: u8 = 1 << 2;
+bitflags::bitflags! {
+    /// Fault bits of the FOG temperature compensation (frame byte 82).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub struct FogTempFlags: u8 {
+        /// The coil sensor is bad (failed, implausible or stuck): last good
+        /// temperature held.
+        const COIL_SENSOR = 1 << 0;
+        /// Coil temperature outside the calibrated range: end node used.
+        const OUT_OF_RANGE = 1 << 1;
+        /// The stored table was refused: no compensation.
+        const COEFFS_REFUSED = 1 << 2;
+    }
 }
 
 /// Immutable fixed-point form of a table for one FOG configuration and
@@ -82,8 +86,8 @@ pub struct FogTempWords {
     pub t_coil_q8: i16,
     /// Coil sensor value in use (held while bad), Q8 degC.
     pub t_sensor_q8: i16,
-    /// [`flags`].
-    pub flags: u8,
+    /// What went wrong, if anything.
+    pub flags: FogTempFlags,
 }
 
 fn q(x: f64, frac: u32) -> i64 {
@@ -127,8 +131,7 @@ impl ScaleFactorConfig {
         // bias rad/s * (n_half tau) s / (angle LSB rad), angle LSB =
         // RAD_PER_PHASE_LSB * tau / K_s: about 71 600 at the reference coil.
         let rad_s_per_dph = core::f64::consts::PI / 180.0 / 3600.0;
-        let per_step =
-            rad_s_per_dph * fog.n_half as f64 * fog.k_sagnac_s / crate::RAD_PER_PHASE_LSB;
+        let per_step = rad_s_per_dph * fog.n_half as f64 * fog.k_sagnac_s / RAD_PER_PHASE_LSB;
         c.angle_per_closure_dph_q8 = q(per_step, 8);
         c
     }
@@ -221,18 +224,20 @@ impl ScaleFactorComp {
         // at the reference coil), but no input may overflow.
         let x = angle.saturating_sub((b_closure_q8 * closures as i64) >> 8);
         let comp = x.saturating_add(mul_q32(x, g));
-        let bit = |on: bool, b: u8| if on { b } else { 0 };
+        let mut flags = FogTempFlags::empty();
+        flags.set(
+            FogTempFlags::COIL_SENSOR,
+            self.sensor_bad || self.t_coil_q8.is_none(),
+        );
+        flags.set(FogTempFlags::OUT_OF_RANGE, out);
+        flags.set(FogTempFlags::COEFFS_REFUSED, cfg.coeffs_refused);
         let sat16 = |v: i32| v.clamp(i16::MIN as i32, i16::MAX as i32) as i16;
         let words = FogTempWords {
             sf_corr_q32: g,
             bias_q16_dph: b_q16,
             t_coil_q8: sat16(t),
             t_sensor_q8: sat16(self.sensor.value_q8()),
-            flags: bit(
-                self.sensor_bad || self.t_coil_q8.is_none(),
-                flags::COIL_SENSOR,
-            ) | bit(out, flags::OUT_OF_RANGE)
-                | bit(cfg.coeffs_refused, flags::COEFFS_REFUSED),
+            flags,
         };
         (comp, words)
     }

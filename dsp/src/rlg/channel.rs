@@ -8,7 +8,7 @@
 //! micro-degrees per second (+-2147 deg/s, LSB 0.0036 deg/h).
 
 use super::counter::PulseCounter;
-use super::thermal::{Temperatures, ThermalComp, ThermalConfig};
+use super::thermal::{RlgFlags, Temperatures, ThermalComp, ThermalConfig};
 
 /// ndps per (deg/h), Q16: 1e9/3600 * 2^16.
 const NDPS_PER_DPH_Q16: i64 = 18_204_444_444;
@@ -60,8 +60,8 @@ pub struct RlgWords {
     pub t_mono_a_q8: i16,
     pub t_mono_b_q8: i16,
     pub t_case_q8: i16,
-    /// [`super::thermal::flags`].
-    pub flags: u8,
+    /// Sensor and coefficient faults.
+    pub flags: RlgFlags,
 }
 
 #[derive(Clone, Copy, Debug, Default)]

@@ -13,4 +13,4 @@ pub mod thermal;
 pub use channel::{compensate_rate_ndps, RlgChannel, RlgConfig, RlgWords};
 pub use coeffs::{CoeffError, ThermalCoeffs};
 pub use counter::PulseCounter;
-pub use thermal::{Temperatures, ThermalComp};
+pub use thermal::{RlgFlags, Temperatures, ThermalComp};

@@ -37,13 +37,19 @@ pub struct Temperatures {
     pub case_q8: Option<i32>,
 }
 
-/// Fault bits of the thermal channel.
-pub mod flags {
-    pub const SENSOR_A: u8 = 1 << 0;
-    pub const SENSOR_B: u8 = 1 << 1;
-    pub const SENSOR_CASE: u8 = 1 << 2;
-    /// The stored coefficients were refused: running on `ThermalCoeffs::SAFE`.
-    pub const COEFFS_DEFAULT: u8 = 1 << 3;
+bitflags::bitflags! {
+    /// Fault bits of the RLG thermal channel (frame byte 60).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub struct RlgFlags: u8 {
+        /// Monoblock sensor A bad: its last good value held.
+        const SENSOR_A = 1 << 0;
+        /// Monoblock sensor B bad: its last good value held.
+        const SENSOR_B = 1 << 1;
+        /// Case sensor bad: its last good value held.
+        const SENSOR_CASE = 1 << 2;
+        /// The stored coefficients were refused: running on `ThermalCoeffs::SAFE`.
+        const COEFFS_DEFAULT = 1 << 3;
+    }
 }
 
 /// Immutable fixed-point form of the coefficients for one sensor update period.
@@ -114,7 +120,7 @@ pub struct ThermalComp {
     grad: Derivative,
     warm_q30: i64,
     bias_q16: i64,
-    flags: u8,
+    flags: RlgFlags,
 }
 
 impl ThermalComp {
@@ -123,15 +129,17 @@ impl ThermalComp {
         let (ta, bad_a) = self.a.take(t.mono_a_q8);
         let (tb, bad_b) = self.b.take(t.mono_b_q8);
         let (tk, bad_k) = self.case.take(t.case_q8);
-        let bit = |on: bool, b: u8| if on { b } else { 0 };
-        self.flags = bit(bad_a, flags::SENSOR_A)
-            | bit(bad_b, flags::SENSOR_B)
-            | bit(bad_k, flags::SENSOR_CASE)
-            | bit(cfg.coeffs_default, flags::COEFFS_DEFAULT);
+        let mut flags = RlgFlags::empty();
+        flags.set(RlgFlags::SENSOR_A, bad_a);
+        flags.set(RlgFlags::SENSOR_B, bad_b);
+        flags.set(RlgFlags::SENSOR_CASE, bad_k);
+        flags.set(RlgFlags::COEFFS_DEFAULT, cfg.coeffs_default);
+        self.flags = flags;
 
         let dt = ((ta - tb) as i64).clamp(-32 * 256, 32 * 256); // Q8
-                                                                // Held values carry no rate: the gradient decays while either
-                                                                // monoblock sensor is bad.
+
+        // Held values carry no rate: the gradient decays while either
+        // monoblock sensor is bad.
         let grad_q32 = self.grad.update(&cfg.grad, dt as i32, !(bad_a || bad_b));
         // |1 - F| <= 2^30, a < 2^26: below 2^56. Rounded shift.
         const HALF: i64 = 1 << 29;
@@ -168,8 +176,8 @@ impl ThermalComp {
     pub fn bias_q16(&self) -> i64 {
         self.bias_q16
     }
-    /// Fault bits ([`flags`]).
-    pub fn flags(&self) -> u8 {
+    /// Fault bits.
+    pub fn flags(&self) -> RlgFlags {
         self.flags
     }
     /// Filtered d(dT)/dt, Q32 degC/s.

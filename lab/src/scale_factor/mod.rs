@@ -400,7 +400,7 @@ pub fn compensate_rows(
             let (a, w) =
                 comp.compensate(cfg, angle.round() as i64, (steps / chunks).round() as u16);
             sum += a as f64;
-            f |= w.flags;
+            f |= w.flags.bits();
         }
         out.push(sum * lsb / DEG / h);
         flags.push(f);

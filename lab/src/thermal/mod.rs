@@ -68,7 +68,7 @@ pub fn firmware_bias(c: &ThermalCoeffs, d: &ThermalData) -> (Vec<i64>, Vec<u8>) 
             },
         );
         bias.push(b);
-        flags.push(comp.flags());
+        flags.push(comp.flags().bits());
     }
     (bias, flags)
 }
