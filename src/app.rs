@@ -5,8 +5,9 @@
 use gyro_coeffs::fog_scale_factor::RECORD_LEN as FOG_SF_RECORD_LEN;
 use gyro_coeffs::rlg_thermal::RECORD_LEN as RLG_RECORD_LEN;
 use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig};
+use gyro_sp::fog::Faults;
 use gyro_sp::fog::{ClosureOutput, FogParams, MAX_HALF, MAX_SAMPLES_PER_HALF};
-use gyro_sp::frame::{Frame, FrameBuilder};
+use gyro_sp::frame::{AngleTotals, Frame, FrameBuilder, ResetCause};
 use gyro_sp::rlg::RlgWords;
 use heapless::spsc::{Producer, Queue};
 
@@ -67,29 +68,46 @@ pub static FOG_SF_RECORD: [u8; FOG_SF_RECORD_LEN] =
     *include_bytes!(concat!(env!("OUT_DIR"), "/fog_sf_coeffs.bin"));
 
 /// The closure interrupt's output side: frames assembled from the closure
-/// outputs, the scale-factor table applied to each, handed to the main loop.
-/// A full queue loses no angle: the frame is folded back into the next.
+/// outputs, the scale-factor table applied to each, handed to the main loop
+/// with cumulative angle words. A full queue loses no angle: the frame is
+/// folded back into the next.
 pub struct FramePath {
     frames: FrameBuilder,
     tx: Producer<'static, Frame, FRAME_QUEUE_LEN>,
     sf_cfg: ScaleFactorConfig,
     sf: ScaleFactorComp,
+    /// Closure periods since start, missed ones included: the frames' time base.
     closures: u32,
+    /// The angle words of the frames sent so far.
+    totals: AngleTotals,
 }
 
 impl FramePath {
+    /// `reset_cause`: why the board started, said by the first frame.
     pub fn new(
         frames: FrameBuilder,
         tx: Producer<'static, Frame, FRAME_QUEUE_LEN>,
         sf_cfg: ScaleFactorConfig,
+        reset_cause: ResetCause,
     ) -> Self {
+        let mut frames = frames;
+        frames.set_reset_cause(reset_cause);
         Self {
             frames,
             tx,
             sf_cfg,
             sf: ScaleFactorComp::default(),
             closures: 0,
+            totals: AngleTotals::default(),
         }
+    }
+
+    /// Closure periods the sampling overran (their samples overwritten,
+    /// their angle lost) before the next closure: counted in the frame and
+    /// in the time base, flagged with `faults`.
+    pub fn lost(&mut self, missed: u32, faults: Faults) {
+        self.closures = self.closures.wrapping_add(missed);
+        self.frames.lost_closures(missed, faults);
     }
 
     /// True when the closure about to be pushed completes a frame: the
@@ -121,15 +139,13 @@ impl FramePath {
         f.compensate_fog(&self.sf, &self.sf_cfg);
     }
 
-    /// Queues a frame for the main loop, or folds it back into the next.
+    /// Queues a frame for the main loop with its angle words made
+    /// cumulative, or folds it back into the next.
     pub fn send(&mut self, f: Frame) {
-        if let Err(f) = self.tx.enqueue(f) {
-            self.frames.restore(f);
+        let (wire, after) = self.totals.stamp(&f);
+        match self.tx.enqueue(wire) {
+            Ok(()) => self.totals = after,
+            Err(_) => self.frames.restore(f),
         }
-    }
-
-    /// A frame to go out first (the board restarted under the watchdog).
-    pub fn restore(&mut self, f: Frame) {
-        self.frames.restore(f);
     }
 }

@@ -7,9 +7,13 @@
 //!
 //! The features only pull in each board's crates (logger, simulator), so both
 //! binaries build together (`--features qemu,hw`) and host builds skip them.
-#![no_std]
+#![cfg_attr(not(test), no_std)]
 
 pub mod app;
+#[cfg(feature = "hw")]
+pub mod i2c;
+pub mod overrun;
+pub mod reset_cause;
 #[cfg(feature = "hw")]
 pub mod sampling;
 #[cfg(feature = "board")]

@@ -9,7 +9,8 @@
 //! TX DMA with the hardware NSS output, and the timers' DMA request and
 //! trigger output.
 
-use crate::app::{ADC_PER_CLOSURE, HALF_PERIODS};
+use crate::app::{ADC_PER_CLOSURE, CLOSURE_HZ, HALF_PERIODS};
+use crate::overrun::{completion_time, judge, overtaken, periods_elapsed, BufferHalf, DmaState};
 use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
 use stm32f4::stm32f405 as pac;
 
@@ -25,6 +26,8 @@ pub struct Sampling {
     adc: pac::ADC1,
     adc_buf: *const u16,
     dac_buf: *mut u16,
+    /// Cycle count at which the DMA completed the half last taken.
+    last_completion: u32,
 }
 
 // The buffers are 'static and only the closure task holds this.
@@ -36,7 +39,26 @@ pub struct Half<'a> {
     pub dac: &'a mut [u16],
     /// The ADC's analog watchdog fired since the last closure.
     pub adc_over_range: bool,
+    /// Which half of the ping-pong this is.
+    pub which: BufferHalf,
 }
+
+/// What one closure interrupt finds.
+pub struct Sampled<'a> {
+    /// The latest complete closure of samples, if there is one to use.
+    pub half: Option<Half<'a>>,
+    /// Closures whose samples were overwritten before this interrupt ran.
+    pub missed: u32,
+    /// The DMA stopped on a transfer error (restarted here).
+    pub dma_error: bool,
+}
+
+/// Samples per closure, as the DMA counts them.
+const PER_CLOSURE: u16 = ADC_PER_CLOSURE as u16;
+/// Core cycles per ADC sample and per closure (168 MHz, 800 kHz, 12.5 kHz).
+const CYCLES_PER_SAMPLE: u32 = 168_000_000 / (CLOSURE_HZ * ADC_PER_CLOSURE as u32);
+const CYCLES_PER_CLOSURE: u32 = CYCLES_PER_SAMPLE * ADC_PER_CLOSURE as u32;
+const _: () = assert!(CYCLES_PER_CLOSURE * CLOSURE_HZ == 168_000_000);
 
 impl Sampling {
     /// Sets up both streams (not yet running the timers), the ADC's analog
@@ -95,39 +117,97 @@ impl Sampling {
             adc,
             adc_buf: adc_buf.as_ptr(),
             dac_buf: dac_buf.as_mut_ptr(),
+            last_completion: 0,
         }
     }
 
-    /// In the stream 0 interrupt: clears its flags and returns the halves
-    /// of the closure just sampled (half transfer: the first, transfer
-    /// complete: the second).
+    /// In the stream 0 interrupt: reads and clears the flags it saw, and
+    /// returns the halves of the latest complete closure (half transfer:
+    /// the first, transfer complete: the second), or none, with the
+    /// closures missed (`overrun::judge`, with the periods between the
+    /// DMA's completion times by the cycle counter `now`, read at entry).
+    /// A transfer error stops the stream in hardware: it is restarted here.
     #[inline(always)]
-    pub fn take_half(&mut self) -> Half<'_> {
-        let second = self.dma.lisr().read().tcif0().is_complete();
+    pub fn take_half(&mut self, now: u32) -> Sampled<'_> {
+        // Flags first, then the position: a completion between the two
+        // reads shows as the DMA past the announced half (counted).
+        let lisr = self.dma.lisr().read();
+        let state = DmaState {
+            half_done: lisr.htif0().is_half(),
+            full_done: lisr.tcif0().is_complete(),
+            error: lisr.teif0().is_error(),
+            remaining: self.dma.st(0).ndtr().read().ndt().bits(),
+        };
+        let completed = completion_time(now, state.remaining, PER_CLOSURE, CYCLES_PER_SAMPLE);
+        let periods = periods_elapsed(
+            completed.wrapping_sub(self.last_completion),
+            CYCLES_PER_CLOSURE,
+        );
+        self.last_completion = completed;
+        // Clear only what was seen: a flag set since stays for the next.
         self.dma.lifcr().write(|w| {
-            w.ctcif0().clear().chtif0().clear().cteif0().clear();
+            if state.half_done {
+                w.chtif0().clear();
+            }
+            if state.full_done {
+                w.ctcif0().clear();
+            }
+            if state.error {
+                w.cteif0().clear();
+            }
             w.cdmeif0().clear().cfeif0().clear()
         });
+        let v = judge(state, PER_CLOSURE, periods);
+        if v.dma_error {
+            let s0 = self.dma.st(0);
+            s0.ndtr().write(|w| w.ndt().set(2 * PER_CLOSURE));
+            s0.cr().modify(|_, w| w.en().enabled());
+        }
         // The watchdog flag is sticky: read and cleared once per closure (a
         // conversion of the closure now sampling may count with this one;
         // that errs safe).
         let adc_over_range = self.adc.sr().read().awd().is_event();
         self.adc.sr().write(|w| w.awd().clear());
-        let (a, d) = if second {
-            (ADC_PER_CLOSURE, HALF_PERIODS)
-        } else {
-            (0, 0)
-        };
-        // SAFETY: both buffers are 'static and the DMA is writing the other
-        // half of the ADC buffer and reading the other half of the DAC
-        // buffer for the whole closure period.
-        unsafe {
-            Half {
-                adc: core::slice::from_raw_parts(self.adc_buf.add(a), ADC_PER_CLOSURE),
-                dac: core::slice::from_raw_parts_mut(self.dac_buf.add(d), HALF_PERIODS),
-                adc_over_range,
+        let half = v.half.map(|which| {
+            let (a, d) = match which {
+                BufferHalf::First => (0, 0),
+                BufferHalf::Second => (ADC_PER_CLOSURE, HALF_PERIODS),
+            };
+            // SAFETY: both buffers are 'static and the DMA is writing the
+            // other half of the ADC buffer (the verdict's half is the
+            // complete one) and reading the other half of the DAC buffer;
+            // `overtaken` checks that this held while the samples were read.
+            unsafe {
+                Half {
+                    adc: core::slice::from_raw_parts(self.adc_buf.add(a), ADC_PER_CLOSURE),
+                    dac: core::slice::from_raw_parts_mut(self.dac_buf.add(d), HALF_PERIODS),
+                    adc_over_range,
+                    which,
+                }
             }
+        });
+        Sampled {
+            half,
+            missed: v.missed,
+            dma_error: v.dma_error,
         }
+    }
+
+    /// Starts the completion clock: `now`, the cycle count when the DMA
+    /// starts (one period before its first completion).
+    pub fn start_clock(&mut self, now: u32) {
+        self.last_completion = now;
+    }
+
+    /// After the closure: the DMA has entered `which` (the samples may have
+    /// changed while they were read).
+    #[inline(always)]
+    pub fn overtaken(&self, which: BufferHalf) -> bool {
+        overtaken(
+            self.dma.st(0).ndtr().read().ndt().bits(),
+            which,
+            PER_CLOSURE,
+        )
     }
 }
 

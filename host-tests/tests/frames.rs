@@ -4,7 +4,7 @@ use gyro_sp::fog::scale_factor::{
     FogTempFlags, FogTempWords, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable,
 };
 use gyro_sp::fog::{ClosureOutput, Faults, FogConfig, FogParams};
-use gyro_sp::frame::{Frame, FrameBuilder, FrameError, FRAME_LEN};
+use gyro_sp::frame::{Frame, FrameBuilder, FrameError, ResetCause, FRAME_LEN};
 use gyro_sp::rlg::{RlgFlags, RlgWords};
 use proptest::prelude::*;
 
@@ -45,6 +45,8 @@ fn round_trip_and_crc() {
             t_sensor_q8: -40 * 256,
             flags: FogTempFlags::from_bits_retain(0b110),
         },
+        reset_cause: ResetCause::HardFault,
+        closures_missed: 3,
     };
     let b = f.encode();
     assert_eq!(Frame::decode(&b), Ok(f));
@@ -58,6 +60,14 @@ fn round_trip_and_crc() {
     bad[81] ^= 0x01;
     assert_eq!(Frame::decode(&bad), Err(FrameError::Crc));
     assert_eq!(Frame::decode(&b[..FRAME_LEN - 1]), Err(FrameError::Length));
+    // Another version with a good CRC is a version error, not noise.
+    let mut v3 = b;
+    v3[2] = 3;
+    let crc = gyro_sp::frame::crc16(&v3[2..FRAME_LEN - 2]);
+    v3[FRAME_LEN - 2..].copy_from_slice(&crc.to_le_bytes());
+    assert_eq!(Frame::decode(&v3), Err(FrameError::Version));
+    assert_eq!(gyro_sp::frame::any_version(&v3), Some(3));
+    assert_eq!(gyro_sp::frame::any_version(&bad), None);
 }
 
 /// A table that scales by exactly 1/(1 + 100 ppm) and removes no bias.

@@ -111,3 +111,130 @@ fn nack_raises_flag_and_holds_value() {
     assert!(last > 0);
     bus.done();
 }
+
+/// A model slave for bus recovery: it lost clocks mid-byte and drives SDA
+/// low until it has seen `bits_left` more SCL rising edges; it records the
+/// STOP (SDA rising while SCL is high).
+struct StuckSlave {
+    bits_left: u32,
+    scl_high: bool,
+    sda_released_by_master: bool,
+    rising_edges: u32,
+    stop_seen: bool,
+}
+
+impl StuckSlave {
+    fn sda_level(&self) -> bool {
+        self.sda_released_by_master && self.bits_left == 0
+    }
+}
+
+/// The board's two pins on one shared model (interior mutability, as the
+/// two GPIOs share one bus).
+struct Pin<'a> {
+    bus: &'a std::cell::RefCell<StuckSlave>,
+    is_scl: bool,
+}
+
+impl embedded_hal::digital::ErrorType for Pin<'_> {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for Pin<'_> {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        let mut b = self.bus.borrow_mut();
+        if self.is_scl {
+            b.scl_high = false;
+        } else {
+            b.sda_released_by_master = false;
+        }
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        let mut b = self.bus.borrow_mut();
+        if self.is_scl {
+            if !b.scl_high {
+                b.rising_edges += 1;
+                b.bits_left = b.bits_left.saturating_sub(1);
+            }
+            b.scl_high = true;
+        } else {
+            let was_low = !b.sda_level();
+            b.sda_released_by_master = true;
+            if was_low && b.sda_level() && b.scl_high {
+                b.stop_seen = true;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl embedded_hal::digital::InputPin for Pin<'_> {
+    fn is_high(&mut self) -> Result<bool, Self::Error> {
+        let b = self.bus.borrow();
+        Ok(if self.is_scl {
+            b.scl_high
+        } else {
+            b.sda_level()
+        })
+    }
+    fn is_low(&mut self) -> Result<bool, Self::Error> {
+        self.is_high().map(|h| !h)
+    }
+}
+
+struct NoDelay;
+impl embedded_hal::delay::DelayNs for NoDelay {
+    fn delay_ns(&mut self, _: u32) {}
+}
+
+/// A slave holding SDA through k more bits is freed after exactly k clocks
+/// and sees a STOP; a free bus takes no clock; one held beyond nine clocks
+/// (a dead slave or a short) is reported stuck, never waited on.
+#[test]
+fn bus_recovery_frees_a_held_sda() {
+    for held in 0..=9u32 {
+        let bus = std::cell::RefCell::new(StuckSlave {
+            bits_left: held,
+            scl_high: true,
+            sda_released_by_master: true,
+            rising_edges: 0,
+            stop_seen: false,
+        });
+        let (mut scl, mut sda) = (
+            Pin {
+                bus: &bus,
+                is_scl: true,
+            },
+            Pin {
+                bus: &bus,
+                is_scl: false,
+            },
+        );
+        let r = tmp117::recover_bus(&mut scl, &mut sda, &mut NoDelay);
+        assert_eq!(r, Ok(held), "held for {held} bits");
+        let b = bus.borrow();
+        assert!(b.stop_seen, "no STOP after {held} bits");
+        assert!(b.sda_level() && b.scl_high, "bus left held");
+    }
+    let bus = std::cell::RefCell::new(StuckSlave {
+        bits_left: u32::MAX,
+        scl_high: true,
+        sda_released_by_master: true,
+        rising_edges: 0,
+        stop_seen: false,
+    });
+    let r = tmp117::recover_bus(
+        &mut Pin {
+            bus: &bus,
+            is_scl: true,
+        },
+        &mut Pin {
+            bus: &bus,
+            is_scl: false,
+        },
+        &mut NoDelay,
+    );
+    assert_eq!(r, Err(tmp117::BusStuck));
+    assert_eq!(bus.borrow().rising_edges, tmp117::MAX_CLOCKS);
+}

@@ -110,6 +110,17 @@ where
         )
     }
 
+    /// A closure the firmware missed (its interrupt ran too late, so its
+    /// samples were overwritten): the optics run on the words already
+    /// applied, which the DMA sends again, and the core never sees them.
+    pub fn skip_closure(&mut self) {
+        let _ = self.simulate_optics();
+        self.closure_index += 1;
+        if self.cfg.params.dac_latency != 0 {
+            self.dac.swap(0, 1);
+        }
+    }
+
     /// Completes a closure run as `simulate_optics` + `process_core`.
     pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigClosure<F> {
         self.closure_index += 1;

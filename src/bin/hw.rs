@@ -14,6 +14,11 @@
 //!   closes the loop as a Smith predictor (docs/fog.md); the host rigs
 //!   simulate the same ping-pong (host-tests `fog_latency`).
 //! - Frames on USART1 (PA9) at 2 Mbaud; independent watchdog at 100 ms.
+//! - Nothing lost silently: a closure that runs late (the DMA past the half
+//!   it should read) is counted and flagged in the frame (`overrun.rs`,
+//!   timed by the cycle counter); a DMA transfer error restarts the stream,
+//!   flagged; a HardFault logs, leaves a mark in RAM and resets, and the
+//!   first frame after any start says why it started (`reset_cause.rs`).
 //! - RLG: the readout's quadrature pair on PB6/PB7 counts in TIM4's encoder
 //!   mode (x4, input filter 8 samples). The RLG update task (TIM5, 500 Hz,
 //!   below the closure's priority) reads and differences the counter and
@@ -22,22 +27,26 @@
 //! - Temperatures: TMP117s on I2C1 (PB8/PB9): 0x48 monoblock A, 0x49
 //!   monoblock B, 0x4A case (10 Hz), 0x4B FOG coil (1 Hz). The idle loop
 //!   reads them and queues the readings to the tasks, so no bus transfer runs
-//!   in an interrupt. Coefficients come from the build-time records
+//!   in an interrupt; every wait on the bus is bounded and a bus held low is
+//!   clocked free (`i2c.rs`), so a dead sensor never stalls the frames. Coefficients come from the build-time records
 //!   (build.rs: `RLG_COEFFS`, `FOG_SF_COEFFS`) and are checked at start.
 
 #![no_std]
 #![no_main]
 
 use core::sync::atomic::{AtomicU32, Ordering};
+use cortex_m::peripheral::DWT;
 use defmt_rtt as _;
 use gyro_fw::app::{
     fog_params, FramePath, FrameQueue, RlgQueue, ADC_PER_CLOSURE, CLOSURES_PER_FRAME, CLOSURE_HZ,
     FOG_SF_RECORD, FRAME_QUEUE_LEN, HALF_PERIODS, RLG_HZ, RLG_QUEUE_LEN, RLG_RECORD, SENSOR_EVERY,
 };
+use gyro_fw::i2c::I2c1;
+use gyro_fw::reset_cause::{reset_cause, HARD_FAULT_MARK};
 use gyro_fw::sampling::{self, AdcBuffer, DacBuffer, Sampling};
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig, FogLoop};
-use gyro_sp::frame::{Frame, FrameBuilder};
+use gyro_sp::frame::{Frame, FrameBuilder, ResetCause};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{RlgChannel, RlgConfig, RlgWords};
 use heapless::spsc::{Consumer, Producer, Queue};
@@ -49,7 +58,6 @@ use stm32f4xx_hal::{
         Adc,
     },
     gpio::Speed,
-    i2c::{DutyCycle, I2c, Mode as I2cMode},
     pac::{self, I2C1, TIM4, TIM5, USART1},
     prelude::*,
     qei::Qei,
@@ -79,6 +87,11 @@ type TempQueue = Queue<Temperatures, 2>;
 type CoilQueue = Queue<Option<i32>, 2>;
 /// RLG updates so far (the idle loop times the sensor reads by it).
 static RLG_TICKS: AtomicU32 = AtomicU32::new(0);
+/// Left by the HardFault handler before it resets; in RAM that start-up
+/// does not initialise, so the next start reads it (garbage after power-on,
+/// which the cause ignores).
+#[link_section = ".uninit.RESET_MARK"]
+static RESET_MARK: AtomicU32 = AtomicU32::new(0);
 
 /// The closure task's state.
 pub struct Closure {
@@ -104,7 +117,7 @@ pub struct RlgTask {
 pub struct Housekeeping {
     frames: Consumer<'static, Frame, FRAME_QUEUE_LEN>,
     usart: Tx<USART1>,
-    i2c: I2c<I2C1>,
+    i2c: I2c1,
     sensors: [Tmp117; 3],
     coil_sensor: Tmp117,
     temps: Producer<'static, Temperatures, 2>,
@@ -145,8 +158,15 @@ mod app {
     fn init(cx: init::Context) -> (Shared, Local) {
         gyro_fw::stack::paint();
         let dp = cx.device;
-        let watchdog_reset = dp.RCC.csr().read().wdgrstf().bit_is_set();
+        let mut core = cx.core;
+        let cause = reset_cause(
+            dp.RCC.csr().read().bits(),
+            RESET_MARK.swap(0, Ordering::Relaxed),
+        );
         dp.RCC.csr().modify(|_, w| w.rmvf().set_bit());
+        // The cycle counter times the closures (missed ones are counted).
+        core.DCB.enable_trace();
+        core.DWT.enable_cycle_counter();
         let mut rcc = dp.RCC.freeze(
             Config::hse(8.MHz())
                 .sysclk(168.MHz())
@@ -162,12 +182,12 @@ mod app {
         ) else {
             reset()
         };
-        let mut i2c = I2c::new(
-            dp.I2C1,
-            (gpiob.pb8, gpiob.pb9),
-            I2cMode::fast(400.kHz(), DutyCycle::Ratio2to1),
-            &mut rcc,
-        );
+        // The bounded I2C driver (the HAL's waits have no bound): PB8/PB9
+        // are set up by it, GPIOB's clock is on (split above).
+        I2C1::enable(&mut rcc);
+        // SAFETY: the driver touches only PB8/PB9's bits of GPIOB, which
+        // nothing else uses (the HAL's split handles of PB8/PB9 are dropped).
+        let mut i2c = I2c1::new(dp.I2C1, unsafe { pac::GPIOB::steal() });
         let sensors = [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)];
         let coil_sensor = Tmp117::new(0x4B);
         for s in sensors.iter().chain([&coil_sensor]) {
@@ -245,7 +265,7 @@ mod app {
         adc.configure_channel(&pa0, Sequence::One, SampleTime::Cycles_3);
         let adc_dr = adc.data_register_address();
         pac::DMA2::enable(&mut rcc);
-        let sampling = Sampling::new(
+        let mut sampling = Sampling::new(
             dp.DMA2,
             // SAFETY: the HAL's Adc configured the converter and is kept
             // (never used again, `Housekeeping::_sampling`); this handle
@@ -267,17 +287,15 @@ mod app {
         let (words, rlg_words) = cx.local.rlg_queue.split();
         let (temps_tx, temps_rx) = cx.local.temp_queue.split();
         let (coil_tx, coil_rx) = cx.local.coil_queue.split();
-        let mut out = FramePath::new(
+        // The first frame says why the board started.
+        let out = FramePath::new(
             FrameBuilder::new(CLOSURES_PER_FRAME, cfg.n_half),
             tx,
             sf_cfg,
+            cause,
         );
-        if watchdog_reset {
-            // Tell the host through the first frame that the board restarted.
-            out.restore(Frame {
-                faults: Faults::RESET_RECOVERED,
-                ..Frame::default()
-            });
+        if cause != ResetCause::PowerOn {
+            defmt::warn!("started after a reset: {}", cause as u8);
         }
         let mut watchdog = IndependentWatchdog::new(dp.IWDG);
         watchdog.start(100.millis());
@@ -295,6 +313,9 @@ mod app {
             CLOSURE_HZ,
             RLG_HZ
         );
+        // The DMA's first completion comes one closure period after the
+        // timers started (a few hundred cycles ago: far below half a period).
+        sampling.start_clock(DWT::cycle_count());
         (
             Shared {},
             Local {
@@ -368,10 +389,29 @@ mod app {
     #[task(binds = DMA2_STREAM0, priority = 2, local = [closure])]
     fn closure(cx: closure::Context) {
         let c = cx.local.closure;
-        let half = c.sampling.take_half();
+        let s = c.sampling.take_half(DWT::cycle_count());
+        let mut faults = Faults::empty();
+        faults.set(Faults::CLOSURE_OVERRUN, s.missed > 0);
+        faults.set(Faults::DMA_ERROR, s.dma_error);
+        // Safe path of a missed closure: its angle is lost, so the frame
+        // counts it (and the time base moves on); the loop carries on.
+        let (missed, half) = (s.missed, s.half);
+        if !faults.is_empty() {
+            c.out.lost(missed, faults);
+        }
+        let Some(half) = half else {
+            // No complete closure to use (a transfer error): no new DAC
+            // words, the DMA repeats the last ones (a valid square wave).
+            return;
+        };
+        let which = half.which;
         let out = c
             .fog
             .process(&c.cfg, half.adc, half.adc_over_range, half.dac);
+        if c.sampling.overtaken(which) {
+            // The DMA entered the half while it was read: flag the closure.
+            c.out.lost(0, Faults::CLOSURE_OVERRUN);
+        }
         if c.out.frame_ends() {
             // The RLG words since the last frame.
             while let Some(w) = c.rlg_words.dequeue() {
@@ -405,6 +445,15 @@ mod app {
 }
 
 fn reset() -> ! {
+    cortex_m::peripheral::SCB::sys_reset()
+}
+
+/// Safe path of a hard fault: log where, leave the mark, reset; the first
+/// frame after the restart says `HardFault` (and RESET_RECOVERED).
+#[cortex_m_rt::exception]
+unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    RESET_MARK.store(HARD_FAULT_MARK, Ordering::Relaxed);
+    defmt::error!("HardFault at pc {=u32:#x}, lr {=u32:#x}", ef.pc(), ef.lr());
     cortex_m::peripheral::SCB::sys_reset()
 }
 

@@ -27,6 +27,14 @@
 //! than the closure (one sensor read per frame stands for 2 s; the sweep is
 //! 1.44 degC/min in that time), and the firmware's table is configured for
 //! that sensor period. The frame path applies the table (`FOG_SF_COEFFS`).
+//!
+//! Missed closures: QEMU has no ADC DMA, so the board keeps a simulated one
+//! ([`VirtualDma`]) on TIM2's free-running count (QEMU's timer runs on
+//! virtual time) and judges it with the hw board's `overrun::judge`. Once,
+//! in the final rest segment, the idle loop masks interrupts for 2.2 closure
+//! periods: the next closure's samples are overwritten before
+//! it can run, the rig's optics run on without the core, and the frame
+//! carries the fault and the count.
 
 #![no_std]
 #![no_main]
@@ -38,6 +46,7 @@ use gyro_fw::app::{
     fog_params, FramePath, FrameQueue, RlgQueue, CLOSURES_PER_FRAME, CLOSURE_HZ, FOG_SF_RECORD,
     RLG_HZ, RLG_RECORD, SAMPLES_PER_HALF, SENSOR_EVERY,
 };
+use gyro_fw::overrun::{judge, DmaState};
 use gyro_fw::{stack, uart};
 use gyro_sim::{
     profile::qemu_demo, Chamber, ChamberParams, CoilThermal, FogRig, OpticsParams, Profile,
@@ -45,7 +54,7 @@ use gyro_sim::{
 };
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig};
-use gyro_sp::frame::FrameBuilder;
+use gyro_sp::frame::{FrameBuilder, ResetCause};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{RlgChannel, RlgConfig};
 use heapless::spsc::{Consumer, Producer};
@@ -65,6 +74,11 @@ const COIL_START_C: f64 = 30.0;
 const COIL_RATE_C_PER_S: f64 = 24.0;
 /// TMP117 address of the FOG coil sensor (the fourth ADD0 address).
 const COIL_SENSOR: u8 = 0x4B;
+/// The idle loop holds the closure off for 2.2 periods once it has run
+/// this many closures (in the final rest segment, after the power loss).
+const OVERRUN_AT: u32 = 29_200;
+/// ADC samples per closure, as the hw DMA counts them.
+const ADC_PER_CLOSURE: u16 = (SAMPLES_PER_HALF * 16) as u16;
 
 /// Set by the closure after its last closure; the idle loop then reports.
 static DONE: AtomicBool = AtomicBool::new(false);
@@ -157,6 +171,68 @@ fn coil_at(t_s: f64) -> f64 {
     COIL_START_C + COIL_RATE_C_PER_S * t_s
 }
 
+/// The hw board's ADC DMA ping-pong, simulated: one half completes at
+/// every SysTick wrap (the closure's period), the first half first. It says
+/// what the DMA's flags and NDTR would read when the closure enters, and
+/// the periods between completions by a cycle counter (TIM2, free-running
+/// on QEMU's virtual clock), as the hw board's cycle counter gives them.
+/// A completion's time is the entry's less SysTick's count since its wrap.
+/// QEMU's virtual clock is only faithful while the CPU runs: in WFI it
+/// follows the host's clock and SysTick's count is skewed after the wake.
+/// But an interrupt that wakes an idle CPU was held off by nothing, so such
+/// an entry is one period, and its own time is the completion.
+pub struct VirtualDma {
+    /// TIM2 ticks per SysTick tick (measured at start).
+    tim2_per_tick: f32,
+    /// TIM2 count of the last completion seen, and completions seen.
+    last: u32,
+    completions: u64,
+}
+
+impl VirtualDma {
+    fn new(tim2_per_tick: f32, now: u32) -> Self {
+        Self {
+            tim2_per_tick,
+            last: now,
+            completions: 0,
+        }
+    }
+
+    /// The DMA registers at TIM2 count `now`, SysTick's count `current`
+    /// and whether the CPU was asleep, and the periods since the last
+    /// completion seen.
+    fn read(&mut self, now: u32, current: u32, woke: bool) -> (DmaState, u32) {
+        let since_wrap = if woke {
+            0
+        } else {
+            RELOAD.saturating_sub(current)
+        };
+        let completed = now.wrapping_sub((since_wrap as f32 * self.tim2_per_tick) as u32);
+        let period = (RELOAD + 1) as f32 * self.tim2_per_tick;
+        let periods = if woke {
+            1
+        } else {
+            // An interrupt means at least one completion.
+            ((completed.wrapping_sub(self.last) as f32 / period + 0.5) as u32).max(1)
+        };
+        self.last = completed;
+        self.completions += periods as u64;
+        let c = ADC_PER_CLOSURE as u32;
+        let into_half = since_wrap * c / (RELOAD + 1);
+        // Completion k (from 1): odd fills the first half, even the second;
+        // the DMA then writes the other.
+        let last_first = self.completions % 2 == 1;
+        let written = if last_first { c + into_half } else { into_half };
+        let state = DmaState {
+            half_done: periods >= 2 || (periods == 1 && last_first),
+            full_done: periods >= 2 || (periods == 1 && !last_first),
+            error: false,
+            remaining: (2 * c - written) as u16,
+        };
+        (state, periods)
+    }
+}
+
 /// SysTick ticks of timed sections: mean and worst.
 #[derive(Clone, Copy, Default)]
 pub struct Bench {
@@ -204,6 +280,11 @@ pub struct ClosureBenches {
     /// Scale-factor table per frame and per coil reading.
     sf_frame: Bench,
     sf_sensor: Bench,
+    /// The overrun check (`overrun::judge` on the DMA's registers).
+    overrun_check: Bench,
+    /// Closures missed, and the closure at which the first was seen.
+    missed: u32,
+    missed_at: u32,
     /// SysTick wrap (the interrupt raised) to the closure's last DAC word,
     /// the simulated optics excluded: closures with the RLG update running
     /// or pending at entry, and those that found the idle loop busy.
@@ -235,6 +316,8 @@ mod app {
         frames: Consumer<'static, gyro_sp::frame::Frame, { gyro_fw::app::FRAME_QUEUE_LEN }>,
         usart: stm32f4::stm32f405::USART1,
         ipt: f32,
+        dma: VirtualDma,
+        tim2: stm32f4::stm32f405::TIM2,
     }
 
     #[init(local = [
@@ -245,7 +328,13 @@ mod app {
         stack::paint();
         let mut syst = cx.core.SYST;
         uart::init(&cx.device.USART1, 42);
-        let ipt = instructions_per_tick(&mut syst);
+        // TIM2 free-running on QEMU's virtual clock: the simulated DMA's time.
+        let tim2 = cx.device.TIM2;
+        tim2.psc().write(|w| w.psc().set(0));
+        tim2.arr().write(|w| unsafe { w.bits(u32::MAX) });
+        tim2.egr().write(|w| w.ug().set_bit());
+        tim2.cr1().modify(|_, w| w.cen().set_bit());
+        let (ipt, tim2_per_tick) = instructions_per_tick(&mut syst, &tim2);
 
         let params = fog_params(0);
         let mut optics =
@@ -306,6 +395,7 @@ mod app {
         syst.set_reload(RELOAD);
         syst.clear_current();
         syst.enable_interrupt();
+        let dma = VirtualDma::new(tim2_per_tick, tim2.cnt().read().bits());
         syst.enable_counter();
         (
             Shared {
@@ -314,10 +404,13 @@ mod app {
             },
             Local {
                 rig,
+                // A QEMU run always starts from power-on (QEMU models no
+                // RCC reset flags to read).
                 out: FramePath::new(
                     FrameBuilder::new(CLOSURES_PER_FRAME, cfg.n_half),
                     tx,
                     sf_cfg,
+                    ResetCause::PowerOn,
                 ),
                 rlg_words,
                 fog_thermal,
@@ -328,6 +421,8 @@ mod app {
                 frames,
                 usart: cx.device.USART1,
                 ipt,
+                dma,
+                tim2,
             },
         )
     }
@@ -337,6 +432,7 @@ mod app {
     #[idle(local = [frames, usart, ipt], shared = [closure_benches, rlg_bench])]
     fn idle(mut cx: idle::Context) -> ! {
         let mut sent = 0u32;
+        let mut overrun_done = false;
         let mut phase = 0u32;
         // SysTick count at the last poll while an RLG update is due.
         let mut last = u32::MAX;
@@ -360,6 +456,13 @@ mod app {
                     last = now;
                 }
                 continue;
+            }
+            if !overrun_done && CLOSURES.load(Ordering::Relaxed) >= OVERRUN_AT {
+                // Fault injection: the closure held off for 2.2 periods (a
+                // long critical section), as a late DMA interrupt would be.
+                overrun_done = true;
+                let turns = (2.2 * (RELOAD + 1) as f32 * *cx.local.ipt / 2.0) as u32;
+                cortex_m::interrupt::free(|_| spin(turns));
             }
             if DONE.load(Ordering::Acquire) && !cx.local.frames.ready() {
                 break;
@@ -397,6 +500,14 @@ mod app {
             smean,
             smax
         );
+        let (omean, omax) = b.overrun_check.instructions(ipt);
+        defmt::info!(
+            "bench: overrun_check_instructions={} overrun_check_max={} closures_missed={} missed_at={}",
+            omean,
+            omax,
+            b.missed,
+            b.missed_at
+        );
         let (lmean, lmax) = b.latency_alone.instructions(ipt);
         let (rl_mean, rl_max) = b.latency_under_rlg.instructions(ipt);
         defmt::info!(
@@ -416,16 +527,38 @@ mod app {
     /// The closure (highest priority): optics simulated, the FOG core run,
     /// the frame assembled. Shares nothing the RLG update locks.
     #[task(binds = SysTick, priority = 2,
-           local = [rig, out, rlg_words, fog_thermal, benches, counter, total],
+           local = [rig, out, rlg_words, fog_thermal, benches, counter, total, dma, tim2],
            shared = [closure_benches])]
     fn closure(mut cx: closure::Context) {
         // Ticks since the SysTick wrap raised this interrupt.
         let entry = RELOAD.saturating_sub(SYST::get_current());
+        // The DMA's registers, and the hw board's verdict on them.
+        let woke = SLEEPING.load(Ordering::Relaxed);
+        let (state, periods) =
+            cx.local
+                .dma
+                .read(cx.local.tim2.cnt().read().bits(), SYST::get_current(), woke);
+        let j0 = SYST::get_current();
+        let verdict = judge(state, ADC_PER_CLOSURE, periods);
+        let j1 = SYST::get_current();
         CLOSURES.fetch_add(1, Ordering::Relaxed);
         let rlg_busy = RLG_RUNNING.load(Ordering::Relaxed)
             || cortex_m::peripheral::NVIC::is_pending(stm32f4::stm32f405::Interrupt::TIM5);
-        let woke = SLEEPING.load(Ordering::Relaxed);
         let l = cx.local;
+        l.benches.overrun_check.record(j0, j1);
+        if verdict.missed > 0 {
+            // The missed closures' samples are gone: the optics run on, the
+            // core does not see them, the frame counts them.
+            // Bounded: a verdict can never stall the closure.
+            for _ in 0..verdict.missed.min(64) {
+                l.rig.skip_closure();
+            }
+            if l.benches.missed == 0 {
+                l.benches.missed_at = *l.counter;
+            }
+            l.benches.missed += verdict.missed;
+            l.out.lost(verdict.missed, Faults::CLOSURE_OVERRUN);
+        }
         if *l.counter >= *l.total {
             if !DONE.swap(true, Ordering::AcqRel) {
                 let b = *l.benches;
@@ -444,7 +577,7 @@ mod app {
         let t1 = SYST::get_current();
         l.benches.core.record(t0, t1);
         let latency = entry + ticks_between(t0, t1);
-        if woke {
+        if woke || verdict.missed > 0 {
             // Not measured (see SLEEPING).
         } else if rlg_busy {
             l.benches.latency_under_rlg.add(latency);
@@ -571,20 +704,36 @@ fn fog_thermal_update(
 }
 
 /// Instructions per SysTick tick, measured on a loop of known length
-/// (2 instructions per turn), so the bench does not assume QEMU's clock.
-fn instructions_per_tick(syst: &mut SYST) -> f32 {
+/// (2 instructions per turn), so the bench does not assume QEMU's clock;
+/// and TIM2 ticks per SysTick tick over the same loop (the simulated DMA's
+/// period).
+fn instructions_per_tick(syst: &mut SYST, tim2: &stm32f4::stm32f405::TIM2) -> (f32, f32) {
     const TURNS: u32 = 20_000;
     syst.set_clock_source(SystClkSource::Core);
     syst.set_reload(0x00FF_FFFF);
     syst.clear_current();
     syst.enable_counter();
     let t0 = SYST::get_current();
-    unsafe {
-        core::arch::asm!("1:", "subs {0}, #1", "bne 1b", inout(reg) TURNS => _, options(nomem, nostack));
-    }
+    let c0 = tim2.cnt().read().bits();
+    spin(TURNS);
     let t1 = SYST::get_current();
+    let c1 = tim2.cnt().read().bits();
     syst.disable_counter();
-    (2 * TURNS) as f32 / (t0.wrapping_sub(t1) & 0x00FF_FFFF).max(1) as f32
+    let ticks = (t0.wrapping_sub(t1) & 0x00FF_FFFF).max(1) as f32;
+    (
+        (2 * TURNS) as f32 / ticks,
+        c1.wrapping_sub(c0) as f32 / ticks,
+    )
+}
+
+/// A loop of `turns` x 2 instructions.
+fn spin(turns: u32) {
+    if turns == 0 {
+        return;
+    }
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, #1", "bne 1b", inout(reg) turns => _, options(nomem, nostack));
+    }
 }
 
 fn fail() -> ! {

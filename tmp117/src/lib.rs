@@ -6,9 +6,14 @@
 //! Any failure is an error, never a guess: a NACK (sensor absent or dead), a
 //! bus fault or timeout, the power-on value 0x8000 (no conversion yet), or a
 //! wrong device ID at probe. The thermal compensation turns an error into a
-//! missing read (flag, hold last good value).
+//! missing read (flag, hold last good value). A bus a slave holds low is
+//! freed by [`recover_bus`].
 
 #![no_std]
+
+mod recovery;
+
+pub use recovery::{recover_bus, BusStuck, HALF_PERIOD_NS, MAX_CLOCKS};
 
 use embedded_hal::i2c::{ErrorKind, I2c, NoAcknowledgeSource};
 

@@ -1,13 +1,14 @@
 //! Decoding of the firmware's UART frames into a run file, and the summary.
 
 use anyhow::{Context, Result};
+use gyro_frames::rows::{fog_rates, RunWriter};
+use gyro_frames::{Decoded, Decoder, Scales, Summary};
 use gyro_sim::profile::qemu_demo;
 use gyro_sim::ChamberParams;
 use gyro_sp::fog::scale_factor::FogTempFlags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
-use gyro_sp::frame::{Frame, FRAME_LEN, SYNC};
+use gyro_sp::frame::Frame;
 use gyro_sp::rlg::RlgFlags;
-use std::io::Write;
 use std::path::Path;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -21,10 +22,8 @@ pub struct Row {
     pub rate: f64,
     pub rate_raw: f64,
     pub rate_comp: f64,
-    /// RLG: compensated rate and counts-only rate, deg/s.
-    pub rlg_rate_dps: f64,
-    pub rlg_rate_raw_dps: f64,
     pub frame: Frame,
+    pub decoded: Decoded,
     pub segment: usize,
     pub t_in_segment: f64,
 }
@@ -36,10 +35,11 @@ pub struct Report {
     pub step_gaps: usize,
     pub segment_names: [&'static str; 8],
     pub cfg: FogConfig,
+    pub summary: Summary,
 }
 
-/// Decodes frames (resynchronising on the sync word) and rebuilds the truth
-/// from the firmware's built-in profile.
+/// Decodes frames through the one decoder (`gyro-frames`, as `gyro-lab
+/// record` does) and rebuilds the truth from the firmware's built-in profile.
 pub fn analyse(path: &Path) -> Result<Report> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
     let cfg = FogConfig::new(FogParams::default()).map_err(|e| anyhow::anyhow!("{e:?}"))?;
@@ -55,129 +55,73 @@ pub fn analyse(path: &Path) -> Result<Report> {
         .collect();
     let n_half = cfg.n_half as u64;
     let tau = cfg.params.tau_s;
-    let counts_per_deg = ChamberParams::default().counts_per_deg;
-    let (mut i, mut bad) = (0usize, 0usize);
+    let scales = Scales::new(&cfg, ChamberParams::default().counts_per_deg);
+    let mut dec = Decoder::new();
+    let mut decoded = Vec::new();
+    dec.push(&bytes, &mut decoded)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut summary = Summary::default();
     let mut rows = Vec::new();
-    let (mut seq_gaps, mut step_gaps) = (0, 0);
-    let mut last: Option<Frame> = None;
-    while i + FRAME_LEN <= bytes.len() {
-        if bytes[i..i + 2] != SYNC {
-            i += 1;
+    let mut step_gaps = 0;
+    for d in decoded {
+        summary.add(&d, &scales);
+        let f = d.frame;
+        if d.span_closures != f.closures as u64 + f.closures_missed as u64 {
+            step_gaps += 1;
+        }
+        let Some(inc) = d.increments else { continue };
+        let Some(r) = fog_rates(&d, &inc, &scales) else {
             continue;
-        }
-        match Frame::decode(&bytes[i..]) {
-            Ok(f) => {
-                if let Some(p) = last {
-                    if f.seq != p.seq.wrapping_add(1) {
-                        seq_gaps += 1;
-                    }
-                    if f.closure_counter.wrapping_sub(p.closure_counter) != f.closures as u32 {
-                        step_gaps += 1;
-                    }
-                }
-                last = Some(f);
-                let end = f.closure_counter as u64;
-                let start = end - f.closures as u64;
-                let mut truth = 0.0;
-                for k in start..end {
-                    for j in 0..n_half {
-                        truth += profile.rate_at(((k * n_half + j) as f64 + 0.5) * tau);
-                    }
-                }
-                let halves = (f.closures as u64 * n_half) as f64;
-                let lsb = cfg.rad_s_per_phase_lsb();
-                let t_mid = (start + end) as f64 / 2.0 * n_half as f64 * tau;
-                let segment = seg_starts.iter().rposition(|&s| t_mid >= s).unwrap_or(0);
-                let frame_s = halves * tau;
-                rows.push(Row {
-                    rlg_rate_dps: f.rlg.rate_comp_udps as f64 * 1e-6,
-                    rlg_rate_raw_dps: f.rlg.delta_counts as f64 / counts_per_deg / frame_s,
-                    t_s: end as f64 * n_half as f64 * tau,
-                    ref_rate: truth / halves,
-                    rate: f.fog_angle as f64 * lsb / halves,
-                    rate_raw: f.fog_angle_raw as f64 * lsb / halves,
-                    rate_comp: f.fog_angle_comp as f64 * lsb / halves,
-                    frame: f,
-                    segment,
-                    t_in_segment: t_mid - seg_starts[segment],
-                });
-                i += FRAME_LEN;
-            }
-            Err(_) => {
-                bad += 1;
-                i += 1;
+        };
+        let end = d.counter;
+        let start = end - d.span_closures;
+        let mut truth = 0.0;
+        for k in start..end {
+            for j in 0..n_half {
+                truth += profile.rate_at(((k * n_half + j) as f64 + 0.5) * tau);
             }
         }
+        let halves = ((end - start) * n_half) as f64;
+        let t_mid = (start + end) as f64 / 2.0 * n_half as f64 * tau;
+        let segment = seg_starts.iter().rposition(|&s| t_mid >= s).unwrap_or(0);
+        rows.push(Row {
+            t_s: end as f64 * n_half as f64 * tau,
+            ref_rate: truth / halves,
+            rate: r.rate_dps * DEG,
+            rate_raw: r.rate_raw_dps * DEG,
+            rate_comp: r.rate_comp_dps * DEG,
+            frame: f,
+            decoded: d,
+            segment,
+            t_in_segment: t_mid - seg_starts[segment],
+        });
     }
+    summary.finish(&dec);
     Ok(Report {
         rows,
-        bad_frames: bad,
-        seq_gaps,
+        bad_frames: dec.crc_errors as usize,
+        seq_gaps: dec.lost_frames as usize,
         step_gaps,
         segment_names: names,
         cfg,
+        summary,
     })
 }
 
-/// The RLG channel's run file (docs/interfaces.md run-file columns).
-pub fn write_rlg_run_file(r: &Report, path: &Path) -> Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(
-        w,
-        "# gyro-fw under qemu-system-arm, RLG channel (simulated chamber at 20 degC); one row per frame"
-    )?;
-    writeln!(w, "t_s,ref_rate_dps,rate_dps,rate_raw_dps,delta_counts,t_mono_a_c,t_mono_b_c,t_case_c,bias_dph,rlg_flags")?;
-    for row in &r.rows {
-        let g = &row.frame.rlg;
-        writeln!(
-            w,
-            "{:.6},{:.9},{:.6},{:.6},{},{:.4},{:.4},{:.4},{:.5},{}",
-            row.t_s,
-            row.ref_rate / DEG,
-            row.rlg_rate_dps,
-            row.rlg_rate_raw_dps,
-            g.delta_counts,
-            g.t_mono_a_q8 as f64 / 256.0,
-            g.t_mono_b_q8 as f64 / 256.0,
-            g.t_case_q8 as f64 / 256.0,
-            g.bias_q16_dph as f64 / 65_536.0,
-            g.flags.bits()
-        )?;
-    }
-    Ok(())
-}
-
-pub fn write_run_file(r: &Report, path: &Path) -> Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(
-        w,
-        "# gyro-fw under qemu-system-arm (netduinoplus2), built-in profile; one row per frame"
-    )?;
-    writeln!(
-        w,
-        "t_s,ref_rate_dps,rate_dps,rate_raw_dps,rate_comp_dps,temp_c,t_coil_c,sf_corr_ppm,fog_bias_dph,fog_temp_flags,faults,seq,dc_lsb,codes_per_turn"
+/// The run files, FOG and RLG, through the same row writer as `gyro-lab
+/// record` (docs/interfaces.md run-file columns and the board's).
+pub fn write_run_files(r: &Report, fog: &Path, rlg: &Path) -> Result<()> {
+    let scales = Scales::new(&r.cfg, ChamberParams::default().counts_per_deg);
+    let mut w = RunWriter::new(
+        std::io::BufWriter::new(std::fs::File::create(fog)?),
+        std::io::BufWriter::new(std::fs::File::create(rlg)?),
+        scales,
+        "gyro-fw under qemu-system-arm (netduinoplus2), built-in profile; RLG in a simulated chamber at 20 degC",
     )?;
     for row in &r.rows {
-        let th = &row.frame.fog_temp;
-        writeln!(
-            w,
-            "{:.6},{:.9},{:.9},{:.9},{:.9},{:.4},{:.4},{:.4},{:.5},{},{},{},{},{:.4}",
-            row.t_s,
-            row.ref_rate / DEG,
-            row.rate / DEG,
-            row.rate_raw / DEG,
-            row.rate_comp / DEG,
-            th.t_sensor_q8 as f64 / 256.0,
-            th.t_coil_q8 as f64 / 256.0,
-            th.sf_corr_q32 as f64 / 4_294_967_296.0 * 1e6,
-            th.bias_q16_dph as f64 / 65_536.0,
-            th.flags.bits(),
-            row.frame.faults.bits(),
-            row.frame.seq,
-            row.frame.dc,
-            row.frame.codes_per_turn_q8 as f64 / 256.0
-        )?;
+        w.row(&row.decoded, row.ref_rate / DEG)?;
     }
+    w.flush()?;
     Ok(())
 }
 
@@ -321,7 +265,12 @@ pub struct RlgStats {
 
 pub fn rlg_stats(r: &Report) -> RlgStats {
     let k = ChamberParams::default().counts_per_deg;
-    let counts: i64 = r.rows.iter().map(|x| x.frame.rlg.delta_counts as i64).sum();
+    let counts: i64 = r
+        .rows
+        .iter()
+        .filter_map(|x| x.decoded.increments)
+        .map(|i| i.rlg_counts)
+        .sum();
     let mut truth = 0.0;
     let mut t_prev = 0.0;
     for x in &r.rows {
@@ -371,6 +320,36 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
         ),
         ("no_panic", !log.contains("panic"), "firmware log".into()),
     ];
+    // The injected overrun (the idle loop holds the closure off for 1.5
+    // periods once): exactly one frame flags it and counts one missed
+    // closure, the time base spans it, the firmware saw the same.
+    let overrun: Vec<&Row> = r
+        .rows
+        .iter()
+        .filter(|x| x.frame.faults.contains(Faults::CLOSURE_OVERRUN))
+        .collect();
+    let logged = log.contains("closures_missed=1 ");
+    v.push((
+        "missed_closure_flagged_and_counted",
+        overrun.len() == 1
+            && overrun[0].frame.closures_missed == 1
+            && overrun[0].decoded.span_closures == 26
+            && r.summary.closures_missed == 1
+            && logged,
+        format!(
+            "{} frames flagged, {} closures missed, firmware log {}",
+            overrun.len(),
+            r.summary.closures_missed,
+            if logged { "agrees" } else { "disagrees" }
+        ),
+    ));
+    v.push((
+        "first_frame_says_power_on",
+        r.summary.starts.len() == 1
+            && r.summary.starts[0].1 == gyro_sp::frame::ResetCause::PowerOn
+            && r.rows.first().is_some_and(|x| x.decoded.counter == 25),
+        format!("starts {:?}", r.summary.starts),
+    ));
     // Locked: every constant-rate segment tracked (mean error under 1 deg/h, no lock
     // fault); the power-loss segment holds the output on purpose and has its own check.
     for s in stats.iter().filter(|s| {

@@ -80,6 +80,78 @@ pub struct QemuRun {
     pub elf: PathBuf,
 }
 
+/// A QEMU run that has written nothing (frames or log) for this long, in
+/// wall-clock time, is hung: it is stopped with an error. A normal run
+/// writes frames every few milliseconds of its own time.
+pub const QEMU_STALL: std::time::Duration = std::time::Duration::from_secs(60);
+/// And no run takes longer than this at all.
+pub const QEMU_LIMIT: std::time::Duration = std::time::Duration::from_secs(20 * 60);
+
+/// qemu-system-arm on the `qemu` firmware, deterministic (-icount
+/// shift=0); `serial`: QEMU's -serial argument (a file, or `pty`).
+pub fn qemu_command(elf: &Path, serial: &str) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args([
+        "-machine",
+        "netduinoplus2",
+        "-cpu",
+        "cortex-m4",
+        "-nographic",
+        "-monitor",
+        "none",
+    ])
+    .args([
+        "-semihosting-config",
+        "enable=on,target=native",
+        "-icount",
+        "shift=0",
+    ])
+    .arg("-serial")
+    .arg(serial)
+    .arg("-kernel")
+    .arg(elf)
+    .stdin(Stdio::null());
+    c
+}
+
+/// Waits for QEMU, stopping it when none of `outputs` has grown for
+/// `stall` ([`QEMU_STALL`]) or the run passes [`QEMU_LIMIT`].
+pub fn wait_progressing(
+    child: &mut std::process::Child,
+    outputs: &[&Path],
+    stall: std::time::Duration,
+) -> Result<std::process::ExitStatus> {
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    let start = std::time::Instant::now();
+    let mut last_change = start;
+    let mut sizes: Vec<u64> = outputs.iter().map(|p| size(p)).collect();
+    loop {
+        if let Some(st) = child.try_wait()? {
+            return Ok(st);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        let now: Vec<u64> = outputs.iter().map(|p| size(p)).collect();
+        if now != sizes {
+            sizes = now;
+            last_change = std::time::Instant::now();
+        }
+        let stalled = last_change.elapsed() > stall;
+        if stalled || start.elapsed() > QEMU_LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            bail!(
+                "QEMU stopped: {} (frames and log at {:?} bytes); the firmware is hung or looping",
+                if stalled {
+                    format!("no output for {} s", stall.as_secs())
+                } else {
+                    format!("still running after {} s", QEMU_LIMIT.as_secs())
+                },
+                sizes
+            );
+        }
+    }
+}
+
 /// Runs the `qemu` firmware deterministically (-icount shift=0) and decodes defmt.
 pub fn run_qemu() -> Result<QemuRun> {
     let elf = build_firmware("qemu")?;
@@ -92,30 +164,11 @@ pub fn run_qemu() -> Result<QemuRun> {
         "$ qemu-system-arm -machine netduinoplus2 ... -kernel {}",
         elf.display()
     );
-    let st = Command::new("qemu-system-arm")
-        .args([
-            "-machine",
-            "netduinoplus2",
-            "-cpu",
-            "cortex-m4",
-            "-nographic",
-            "-monitor",
-            "none",
-        ])
-        .args([
-            "-semihosting-config",
-            "enable=on,target=native",
-            "-icount",
-            "shift=0",
-        ])
-        .arg("-serial")
-        .arg(format!("file:{}", frames_path.display()))
-        .arg("-kernel")
-        .arg(&elf)
-        .stdin(Stdio::null())
+    let mut child = qemu_command(&elf, &format!("file:{}", frames_path.display()))
         .stdout(out)
-        .status()
+        .spawn()
         .context("starting qemu-system-arm")?;
+    let st = wait_progressing(&mut child, &[&frames_path, &raw_log], QEMU_STALL)?;
     let decoded = Command::new("defmt-print")
         .arg("-e")
         .arg(&elf)
@@ -139,11 +192,10 @@ fn qemu_cmd() -> Result<()> {
     let run = run_qemu()?;
     let report = frames::analyse(&run.frames_path)?;
     let csv = root().join("runs").join("qemu-fog.csv");
-    frames::write_run_file(&report, &csv)?;
+    let rlg_csv = root().join("runs").join("qemu-rlg.csv");
+    frames::write_run_files(&report, &csv, &rlg_csv)?;
     frames::print_summary(&report);
     println!("run file: {}", csv.display());
-    let rlg_csv = root().join("runs").join("qemu-rlg.csv");
-    frames::write_rlg_run_file(&report, &rlg_csv)?;
     println!("RLG run file: {}", rlg_csv.display());
     Ok(())
 }
@@ -307,4 +359,31 @@ fn bench_cmd() -> Result<()> {
     });
     println!("{j}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A child that writes nothing is stopped after the stall time with an
+    /// error that says so; one that finishes is waited for.
+    #[test]
+    fn a_stalled_run_is_stopped() {
+        let dir = std::env::temp_dir().join(format!("xtask-stall-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("out.bin");
+        std::fs::write(&out, b"x").unwrap();
+        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
+        let t0 = std::time::Instant::now();
+        let e = wait_progressing(&mut child, &[&out], std::time::Duration::from_secs(1))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no output for 1 s"), "{e}");
+        assert!(t0.elapsed() < std::time::Duration::from_secs(10));
+        assert!(child.try_wait().unwrap().is_some(), "child left running");
+        let mut child = Command::new("true").spawn().unwrap();
+        let st = wait_progressing(&mut child, &[&out], std::time::Duration::from_secs(5)).unwrap();
+        assert!(st.success());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -15,7 +15,14 @@ bitflags::bitflags! {
         const ADC_SATURATION = 1 << 2;
         /// Firmware: a frame could not be queued; its closures went into the next frame.
         const QUEUE_FULL = 1 << 3;
-        /// Firmware: recovered from a panic or watchdog reset.
+        /// Firmware: restarted after a watchdog reset or a hard fault (the
+        /// frame's reset cause says which).
         const RESET_RECOVERED = 1 << 4;
+        /// Firmware: the sampling overran (a closure ran too late, so the DMA
+        /// passed the half it had to read): the frame counts the closures missed.
+        const CLOSURE_OVERRUN = 1 << 5;
+        /// Firmware: the ADC's DMA reported a transfer error; that closure's
+        /// samples were not used.
+        const DMA_ERROR = 1 << 6;
     }
 }
