@@ -26,6 +26,9 @@ impl RateLog {
         if t_s.len() < 2 || t_s.len() != rate_dps.len() {
             return Err(RateLogError::TooShort);
         }
+        if !(t_s[0].is_finite() && rate_dps[0].is_finite()) {
+            return Err(RateLogError::NotIncreasing { index: 0 });
+        }
         for i in 1..t_s.len() {
             if t_s[i].is_nan() || t_s[i] <= t_s[i - 1] || !rate_dps[i].is_finite() {
                 return Err(RateLogError::NotIncreasing { index: i });
