@@ -191,12 +191,13 @@ fn qemu_cmd() -> Result<()> {
     setup::ensure_all()?;
     let run = run_qemu()?;
     let report = frames::analyse(&run.frames_path)?;
-    let csv = root().join("runs").join("qemu-fog.csv");
-    let rlg_csv = root().join("runs").join("qemu-rlg.csv");
-    frames::write_run_files(&report, &csv, &rlg_csv)?;
+    let runs = root().join("runs");
+    let reference = frames::write_reference(&runs.join("qemu-reference.csv"))?;
+    let dir = runs.join("qemu");
+    frames::record_capture(&run.frames_path, &dir, reference)?;
     frames::print_summary(&report);
-    println!("run file: {}", csv.display());
-    println!("RLG run file: {}", rlg_csv.display());
+    println!("run file: {}", dir.join("fog.csv").display());
+    println!("RLG run file: {}", dir.join("rlg.csv").display());
     Ok(())
 }
 
