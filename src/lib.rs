@@ -14,5 +14,6 @@ pub mod app;
 pub mod sampling;
 #[cfg(feature = "board")]
 pub mod stack;
+pub mod timing;
 #[cfg(feature = "qemu")]
 pub mod uart;
