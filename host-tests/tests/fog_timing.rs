@@ -260,8 +260,7 @@ fn sampling_phase_sweep() {
         below_margin >= MIN_MARGIN_TICKS && above_margin >= MIN_MARGIN_TICKS,
         "margins {below_margin} / {above_margin} ticks, at least {MIN_MARGIN_TICKS}"
     );
-    // Outside: the sample train started with the DAC word (phase 0, what two
-    // timers started back to back give, give or take the code's cycles), and a
+    // Outside: the sample train started with the DAC word (phase 0), and a
     // quarter sample period past the upper edge. Both leak the transient into
     // kept samples, and both show it as a bias and a scale-factor error.
     for ph in [0, hi_edge + 52] {
