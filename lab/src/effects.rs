@@ -74,7 +74,7 @@ impl Inputs {
     ) -> Self {
         let (dt, grad) = match mono {
             Some((a, b)) => {
-                let (d, g) = crate::thermal::fit::dt_and_gradient(&t, &a, &b);
+                let (d, g) = crate::numerics::thermal_difference::dt_and_gradient(&t, &a, &b);
                 (Some(d), Some(g))
             }
             None => (None, None),

@@ -8,7 +8,7 @@
 //! rate) -1, rate random walk -2 (a rate ramp is not noise: it is given
 //! -2's degrees of freedom, the fewest).
 
-use crate::stats::chi2_quantile;
+use crate::numerics::stats::chi2_quantile;
 
 /// Allan variance: second differences.
 const D: f64 = 2.0;

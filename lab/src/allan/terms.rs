@@ -110,7 +110,7 @@ fn nnls(taus: &[f64], avar: &[f64], w: &[f64], active: &[bool; COUNT]) -> [f64; 
             .iter()
             .map(|&j| taus.iter().map(|&t| basis(j, t)).collect())
             .collect();
-        let Some(f) = crate::lsq::wls(&cols, avar, Some(w)) else {
+        let Some(f) = crate::numerics::lsq::wls(&cols, avar, Some(w)) else {
             continue;
         };
         if f.coef.iter().any(|&c| c < 0.0) {
@@ -275,7 +275,7 @@ fn check(taus: &[f64], c: &[f64; COUNT], model: &[f64], edf: &[f64]) -> Check {
     });
     let meat = wx.transpose() * sigma * &wx;
     let cov = &bread * meat * &bread;
-    let z = crate::stats::normal_quantile(0.5 + CONF / 2.0);
+    let z = crate::numerics::stats::normal_quantile(0.5 + CONF / 2.0);
     for (k, &j) in idx.iter().enumerate() {
         let se = cov[(k, k)].max(0.0).sqrt() / scale[k];
         lo[j] = c[j] - z * se;

@@ -18,8 +18,8 @@
 //! effects are judged on the rest.
 
 use crate::effects::{Effect, Inputs};
-use crate::lsq::{wls, LsFit};
-use crate::search::{golden, grid_then_golden, profile_interval, CHI2_1_95};
+use crate::numerics::lsq::{wls, LsFit};
+use crate::numerics::search::{golden, grid_then_golden, profile_interval, CHI2_1_95};
 
 /// BIC decrease an effect must bring to be named ("very strong" evidence).
 pub const BIC_THRESHOLD: f64 = 10.0;

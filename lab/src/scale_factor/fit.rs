@@ -21,8 +21,8 @@
 //!   tested on the plateau points (BIC), its interval is where the points
 //!   cannot place it.
 
-use crate::lsq::{wls, LsFit};
-use crate::search::{golden, grid_then_golden, profile_interval, CHI2_1_95};
+use crate::numerics::lsq::{wls, LsFit};
+use crate::numerics::search::{golden, grid_then_golden, profile_interval, CHI2_1_95};
 use gyro_coeffs::fog_scale_factor::{ScaleFactorTable, MAX_NODES};
 use gyro_sp::fog::scale_factor::{ScaleFactorComp, ScaleFactorConfig, LEAD_FILTER_TAU_S};
 use gyro_sp::fog::{FogConfig, FogParams};

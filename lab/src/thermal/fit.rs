@@ -8,7 +8,7 @@
 //! linear in its coefficients once tau_warm is fixed; tau_warm is searched
 //! (log grid, then golden section) for the least residual.
 
-use gyro_sp::rlg::thermal::GRAD_TAU_S;
+use crate::numerics::thermal_difference::dt_and_gradient;
 use gyro_sp::rlg::ThermalCoeffs;
 
 /// Inputs of a fit, one row per sample.
@@ -21,28 +21,9 @@ pub struct ThermalData {
     pub drift_dph: Vec<f64>,
 }
 
-/// dT = a - b and its filtered gradient, as the firmware forms them.
-pub fn dt_and_gradient(t: &[f64], a: &[f64], b: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let n = t.len();
-    let mut dts: Vec<f64> = Vec::with_capacity(n);
-    let mut grads = Vec::with_capacity(n);
-    let mut grad = 0.0;
-    for k in 0..n {
-        let dtk = (a[k] - b[k]).clamp(-32.0, 32.0);
-        if k > 0 {
-            let h = t[k] - t[k - 1];
-            let slope = ((dtk - dts[k - 1]) / h).clamp(-8.0, 8.0);
-            grad += h / (GRAD_TAU_S + h) * (slope - grad);
-        }
-        dts.push(dtk);
-        grads.push(grad);
-    }
-    (dts, grads)
-}
-
 /// Least squares: the coefficients and the residual.
 fn lstsq(cols: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
-    crate::lsq::wls(cols, y, None).map(|f| (f.coef, f.resid))
+    crate::numerics::lsq::wls(cols, y, None).map(|f| (f.coef, f.resid))
 }
 
 pub(crate) fn sse(r: &[f64]) -> f64 {
@@ -65,7 +46,7 @@ pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
     // Log grid 30 s .. 30 000 s, then golden section around the best.
     let (lo, hi) = (30f64.ln(), 30_000f64.ln());
     let grid: Vec<f64> = (0..=24).map(|i| lo + (hi - lo) * i as f64 / 24.0).collect();
-    let (best, _) = crate::search::grid_then_golden(cost, &grid, 40);
+    let (best, _) = crate::numerics::search::grid_then_golden(cost, &grid, 40);
     let tau = best.exp();
     let (c, r) = solve(tau)?;
     Some((
@@ -88,7 +69,7 @@ pub fn fit_thermal(d: &ThermalData) -> Option<(ThermalCoeffs, Vec<f64>)> {
 /// means (the variance of 100 s means over what white noise would give);
 /// tau_warm from the curvature of the residual sum in ln(tau).
 pub fn coefficient_se(d: &ThermalData, c: &ThermalCoeffs) -> Option<ThermalCoeffs> {
-    let f = crate::lsq::wls(&columns(d, c.tau_warm_s), &d.drift_dph, None)?;
+    let f = crate::numerics::lsq::wls(&columns(d, c.tau_warm_s), &d.drift_dph, None)?;
     let n = d.t.len() as f64;
     let var = f.sse / (n - 7.0).max(1.0);
     let dt = (d.t[d.t.len() - 1] - d.t[0]) / (n - 1.0).max(1.0);
@@ -100,7 +81,8 @@ pub fn coefficient_se(d: &ThermalData, c: &ThermalCoeffs) -> Option<ThermalCoeff
     let inflation = (var_means * per / var).max(1.0);
     let v = var * inflation;
     let sse_at = |lt: f64| {
-        crate::lsq::wls(&columns(d, lt.exp()), &d.drift_dph, None).map_or(f64::NAN, |f| f.sse)
+        crate::numerics::lsq::wls(&columns(d, lt.exp()), &d.drift_dph, None)
+            .map_or(f64::NAN, |f| f.sse)
     };
     let (l0, h) = (c.tau_warm_s.ln(), 0.05);
     let curv = (sse_at(l0 + h) - 2.0 * f.sse + sse_at(l0 - h)) / (h * h);
