@@ -22,6 +22,8 @@
 //! | case_temperature | k4 (T_K - 20)/3600 | t_case_c |
 //! | warm_up | A (1 - exp(-t/tau))/3600, t since power-on | - |
 
+use crate::data::run_file::Column;
+
 /// Which gyro a model or run is of.
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
@@ -225,13 +227,13 @@ impl Effect {
     }
 
     /// The run columns the effect needs, and whether `inp` has them.
-    pub fn needs(self) -> &'static [&'static str] {
+    pub fn needs(self) -> &'static [Column] {
         match self {
-            Effect::ScaleFactorTemperature | Effect::ScaleFactorKnee => &["temp_c"],
+            Effect::ScaleFactorTemperature | Effect::ScaleFactorKnee => &[Column::Temp],
             Effect::ThermalDifference
             | Effect::ThermalGradient
-            | Effect::ThermalDifferenceSquared => &["t_mono_a_c", "t_mono_b_c"],
-            Effect::CaseTemperature => &["t_case_c"],
+            | Effect::ThermalDifferenceSquared => &[Column::MonoA, Column::MonoB],
+            Effect::CaseTemperature => &[Column::Case],
             _ => &[],
         }
     }

@@ -5,6 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod allan;
+pub mod data;
 pub mod discover;
 pub mod effects;
 pub mod error;
@@ -14,5 +15,4 @@ pub mod numerics;
 pub mod report;
 pub mod scale_factor;
 pub mod simulate;
-pub mod table;
 pub mod thermal;

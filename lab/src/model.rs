@@ -17,7 +17,9 @@
 //! slope_change_ppm_per_c = 6.0
 //! ```
 
+use crate::data::run_file::Column;
 use crate::effects::{Effect, GyroKind, Inputs};
+use crate::error::{ColumnRef, LabError};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -56,12 +58,21 @@ struct RawEffect {
     params: BTreeMap<String, toml::Value>,
 }
 
-/// `file:line:column` of a byte offset.
-fn place(path: &Path, text: &str, offset: usize) -> String {
+/// An error at a byte offset of the model file: its line and character
+/// column.
+fn error_at(path: &Path, text: &str, offset: usize, msg: String) -> LabError {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
     let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    format!("{}:{line}:{col}", path.display())
+    LabError::at(
+        path,
+        line as u64,
+        ColumnRef {
+            index: col,
+            name: None,
+        },
+        msg,
+    )
 }
 
 impl Model {
@@ -76,43 +87,48 @@ impl Model {
 
     /// Reads and checks a model file for a gyro of kind `expect`; errors are
     /// one line, `file:line:column: message`.
-    pub fn read(path: &Path, expect: GyroKind) -> Result<Self, String> {
-        let name = path.display();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
+    pub fn read(path: &Path, expect: GyroKind) -> Result<Self, LabError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
         let raw: RawModel = toml::from_str(&text).map_err(|e| {
             let msg = e.message().replace('\n', " ");
             match e.span() {
-                Some(s) => format!("{}: {msg}", place(path, &text, s.start)),
-                None => format!("{name}: {msg}"),
+                Some(s) => error_at(path, &text, s.start, msg),
+                None => LabError::input(path, msg),
             }
         })?;
-        let at = |s: std::ops::Range<usize>| place(path, &text, s.start);
+        let at = |s: std::ops::Range<usize>, msg: String| error_at(path, &text, s.start, msg);
         if raw.kind.get_ref() != "gyro_model" {
-            return Err(format!(
-                "{}: kind `{}`: not a gyro model (kind = \"gyro_model\")",
-                at(raw.kind.span()),
-                raw.kind.get_ref()
+            return Err(at(
+                raw.kind.span(),
+                format!(
+                    "kind `{}`: not a gyro model (kind = \"gyro_model\")",
+                    raw.kind.get_ref()
+                ),
             ));
         }
         if *raw.version.get_ref() != VERSION {
-            return Err(format!(
-                "{}: version {} (this tool reads version {VERSION})",
-                at(raw.version.span()),
-                raw.version.get_ref()
+            return Err(at(
+                raw.version.span(),
+                format!(
+                    "version {} (this tool reads version {VERSION})",
+                    raw.version.get_ref()
+                ),
             ));
         }
         let gyro = match raw.gyro.get_ref().as_str() {
             "fog" => GyroKind::Fog,
             "rlg" => GyroKind::Rlg,
-            g => return Err(format!("{}: gyro `{g}`: fog or rlg", at(raw.gyro.span()))),
+            g => return Err(at(raw.gyro.span(), format!("gyro `{g}`: fog or rlg"))),
         };
         if gyro != expect {
-            return Err(format!(
-                "{}: a model of the {} but --gyro {}",
-                at(raw.gyro.span()),
-                gyro.name(),
-                expect.name()
+            return Err(at(
+                raw.gyro.span(),
+                format!(
+                    "a model of the {} but --gyro {}",
+                    gyro.name(),
+                    expect.name()
+                ),
             ));
         }
         let mut effects = vec![];
@@ -122,44 +138,47 @@ impl Model {
             let n = e.name.get_ref();
             let Some(effect) = Effect::from_name(n) else {
                 let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
-                return Err(format!(
-                    "{}: unknown effect `{n}` (the effects are {})",
-                    at(e.name.span()),
-                    names.join(", ")
+                return Err(at(
+                    e.name.span(),
+                    format!(
+                        "unknown effect `{n}` (the effects are {})",
+                        names.join(", ")
+                    ),
                 ));
             };
             if !effect.applies_to(gyro) {
-                return Err(format!(
-                    "{}: `{n}` is not an effect of the {}",
-                    at(e.name.span()),
-                    gyro.name()
+                return Err(at(
+                    e.name.span(),
+                    format!("`{n}` is not an effect of the {}", gyro.name()),
                 ));
             }
             let mut params = BTreeMap::new();
             for (k, v) in &e.params {
                 if !effect.params().contains(&k.as_str()) {
-                    return Err(format!(
-                        "{}: effect `{n}` has no parameter `{k}` (its parameters: {})",
-                        at(span.clone()),
-                        effect.params().join(", ")
+                    return Err(at(
+                        span.clone(),
+                        format!(
+                            "effect `{n}` has no parameter `{k}` (its parameters: {})",
+                            effect.params().join(", ")
+                        ),
                     ));
                 }
                 let x = v.as_float().or(v.as_integer().map(|i| i as f64));
                 match x {
                     Some(x) if x.is_finite() => params.insert(k.clone(), x),
                     _ => {
-                        return Err(format!(
-                            "{}: effect `{n}`: parameter `{k}` is not a finite number",
-                            at(span.clone())
+                        return Err(at(
+                            span.clone(),
+                            format!("effect `{n}`: parameter `{k}` is not a finite number"),
                         ))
                     }
                 };
             }
             for p in effect.params() {
                 if !params.contains_key(p) {
-                    return Err(format!(
-                        "{}: effect `{n}` lacks parameter `{p}`",
-                        at(span.clone())
+                    return Err(at(
+                        span.clone(),
+                        format!("effect `{n}` lacks parameter `{p}`"),
                     ));
                 }
             }
@@ -198,15 +217,14 @@ impl Model {
         toml::to_string(&t).unwrap_or_default()
     }
 
-    pub fn write(&self, path: &Path, comment: &str) -> Result<(), String> {
+    pub fn write(&self, path: &Path, comment: &str) -> Result<(), LabError> {
         let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
-        std::fs::write(path, format!("{head}{}", self.to_toml()))
-            .map_err(|e| format!("{}: {e}", path.display()))
+        std::fs::write(path, format!("{head}{}", self.to_toml())).map_err(|e| LabError::io(path, e))
     }
 
     /// The effects whose inputs the run lacks (the model cannot be evaluated
     /// on it then), with the columns missing.
-    pub fn missing_inputs(&self, inp: &Inputs) -> Vec<(Effect, &'static [&'static str])> {
+    pub fn missing_inputs(&self, inp: &Inputs) -> Vec<(Effect, &'static [Column])> {
         self.effects
             .iter()
             .filter(|e| !e.effect.available(inp))

@@ -1,12 +1,13 @@
 //! `gyro-lab simulate fog`: the firmware's FOG core closed around the simulated
 //! interferometer and photodetector, sample by sample.
 
+use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
+use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
 use clap::{Args, Subcommand};
 use gyro_sim::{FogRig, OpticsParams, Profile, Segment};
 use gyro_sp::fog::{FogConfig, FogParams};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 const DPH_PER_RAD_S: f64 = 3600.0 / DEG;
@@ -116,7 +117,10 @@ pub fn run(cmd: SimulateCmd) -> Result<(), LabError> {
             if a.json {
                 println!(
                     "{}",
-                    serde_json::to_string(&s).map_err(|e| LabError::Io(e.to_string()))?
+                    serde_json::to_string(&s).map_err(|e| LabError::Io {
+                        file: None,
+                        msg: e.to_string()
+                    })?
                 );
             } else {
                 let pm = |v: f64, se: Option<f64>| match se {
@@ -288,17 +292,20 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
         ProgressBar::hidden()
     };
     let mut writer = match &a.out {
-        Some(p) => {
-            let f = std::fs::File::create(p)
-                .map_err(|e| LabError::Io(format!("{}: {e}", p.display())))?;
-            let mut w = std::io::BufWriter::new(f);
-            writeln!(w, "# gyro-lab simulate fog: means over 25 closure steps")?;
-            writeln!(
-                w,
-                "t_s,ref_rate_dps,rate_dps,rate_raw_dps,ref_acc_dps2,residual_rad,codes_per_turn,faults"
-            )?;
-            Some(w)
-        }
+        Some(p) => Some(RunWriter::create(
+            p,
+            "gyro-lab simulate fog: means over 25 closure steps",
+            &[
+                (Column::Time, Fixed(6)),
+                (Column::RefRate, Fixed(9)),
+                (Column::Rate, Fixed(9)),
+                (Column::RawRate, Fixed(9)),
+                (Column::RefAcc, Fixed(6)),
+                (Column::LoopResidual, Exp(6)),
+                (Column::CodesPerTurn, Fixed(3)),
+                (Column::Faults, Shortest),
+            ],
+        )?),
         None => None,
     };
     let (mut err_sum, mut raw_sum) = (0.0f64, 0.0f64);
@@ -335,9 +342,7 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
                 // Acceleration at the row's middle: its square samples the
                 // oscillation's phases evenly (the rectification's mean).
                 let t_mid = r.t_end - 12.5 * dt;
-                writeln!(
-                    w,
-                    "{:.6},{:.9},{:.9},{:.9},{:.6},{:.6e},{:.3},{}",
+                w.row(&[
                     t_mid,
                     acc[0] / n / DEG,
                     acc[1] / n / DEG,
@@ -345,8 +350,8 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
                     rig.profile.accel_at(t_mid) / DEG,
                     acc[3] / n,
                     r.out.codes_per_turn_q8 as f64 / 256.0,
-                    r.out.faults.0
-                )?;
+                    r.out.faults.0 as f64,
+                ])?;
                 acc = [0.0; 4];
                 acc_n = 0;
             }
@@ -357,8 +362,8 @@ pub fn simulate_fog(a: &FogArgs) -> Result<FogSummary, LabError> {
     }
     bar.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
-    if let Some(mut w) = writer {
-        w.flush()?;
+    if let Some(w) = writer {
+        w.finish()?;
     }
     let n = avg_steps.max(1) as f64;
     let batch_s = batch_steps as f64 * dt;

@@ -28,7 +28,7 @@ fn continuous_rotation_finds_the_knee_and_compensates_another_run() {
     let f = fit_run_data(&input(&simulate(&continuous_fit_test(), &rig)))
         .unwrap()
         .0;
-    assert_eq!(f.method, "continuous");
+    assert_eq!(f.method.to_string(), "continuous");
     assert_eq!(f.knees.len(), 1, "{:?}", f.knees);
     let k = f.knees[0];
     let truth = rig.truth.knees[0].0;
@@ -80,7 +80,7 @@ fn multipoint_brackets_the_knee_and_measures_asymmetry() {
         ..RigParams::default()
     };
     let (f, plateaus) = fit_run_data(&input(&simulate(&multipoint_test(), &rig))).unwrap();
-    assert_eq!(f.method, "multi-point");
+    assert_eq!(f.method.to_string(), "multi-point");
     let plateaus = plateaus.unwrap();
     assert_eq!(plateaus.len(), 5);
     // Each plateau's scale factor is the truth's at its temperature.

@@ -5,6 +5,8 @@
 
 use super::terms::{self, COUNT, NAMES, UNITS};
 use super::{adev, analyse};
+use crate::data::csv_writer::CellFormat::{Exp, Fixed};
+use crate::data::run_file::{Column, RunWriter, Series as RunSeries};
 use crate::error::LabError;
 use clap::Args;
 use gyro_sim::{NoiseParams, RateNoise};
@@ -129,7 +131,7 @@ pub fn run(a: &AllanBenchArgs) -> Result<(), LabError> {
         }
         for seed in 1..=a.seeds {
             let y = record(&sc.truth, SAMPLES, TAU0_S, seed);
-            let an = analyse(&y, TAU0_S).map_err(LabError::Input)?;
+            let an = analyse(&y, TAU0_S).map_err(|e| LabError::Bench(e.to_string()))?;
             for j in 0..COUNT {
                 let t = &an.terms;
                 if !t.present[j] {
@@ -238,27 +240,30 @@ pub fn speed(a: &SpeedArgs) -> Result<(), LabError> {
     let truth = [0.0, 0.1, 0.05, 0.02, 0.0];
     let y = record(&truth, n, tau0, 1);
     let t0 = std::time::Instant::now();
-    let an = analyse(&y, tau0).map_err(LabError::Input)?;
+    let an = analyse(&y, tau0).map_err(|e| LabError::Bench(e.to_string()))?;
     let fast_s = t0.elapsed().as_secs_f64();
     // The CSV read of the same record.
     let dir = std::env::temp_dir().join(format!("gyro-lab-allan-speed-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let path = dir.join("long.csv");
-    {
-        use std::io::Write;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(&path)?);
-        writeln!(w, "t_s,rate_dps")?;
-        for (k, v) in y.iter().enumerate() {
-            writeln!(w, "{:.2},{:.9e}", (k + 1) as f64 * tau0, v)?;
-        }
-        w.flush()?;
+    let mut w = RunWriter::create(
+        &path,
+        "",
+        &[(Column::Time, Fixed(2)), (Column::Rate, Exp(9))],
+    )?;
+    for (k, v) in y.iter().enumerate() {
+        w.row(&[(k + 1) as f64 * tau0, *v])?;
     }
+    w.finish()?;
     let t1 = std::time::Instant::now();
-    let cols = crate::table::Columns::read(&path, &["t_s", "rate_dps"])?;
+    let series = RunSeries::read(&path, Column::Rate.name())?;
     let read_s = t1.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
-    if cols.len() != n {
-        return Err(LabError::Io(format!("read {} rows of {n}", cols.len())));
+    if series.values.len() != n {
+        return Err(LabError::Io {
+            file: None,
+            msg: format!("read {} rows of {n}", series.values.len()),
+        });
     }
     // The definition on 10^5 samples, at the same averaging factors the
     // fast estimator uses there, and the fast one on the same record.

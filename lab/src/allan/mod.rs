@@ -8,11 +8,11 @@ pub mod bench;
 pub mod edf;
 pub mod terms;
 
+use crate::data::allan_file::{self, AllanRow};
+use crate::data::run_file::{Column, Series as RunSeries};
 use crate::error::LabError;
 use crate::report::{num, sig, Axes, Report, Series};
-use crate::table::Columns;
 use clap::Args;
-use std::io::Write;
 use std::path::PathBuf;
 use terms::{TermFit, COUNT, NAMES, SLOPES, UNITS};
 
@@ -39,21 +39,39 @@ pub struct Allan {
     pub mean_se_dps: f64,
 }
 
+/// Why a record cannot be analysed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum AllanError {
+    /// Fewer than 3 samples (this many).
+    TooShort(usize),
+    /// Every sample the same.
+    Constant,
+}
+
+impl std::fmt::Display for AllanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AllanError::TooShort(n) => write!(
+                f,
+                "{n} samples: too short for even one averaging time (3 needed for tau = tau0)"
+            ),
+            AllanError::Constant => f.write_str(
+                "the record is constant: its Allan deviation is zero, there is no noise to analyse",
+            ),
+        }
+    }
+}
+
 /// Analyses `y` sampled every `tau0` s (the units of `y` carry through:
 /// deg/s for the reported terms; the mean's standard error in `y`'s unit).
-pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, String> {
+pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
     let n = y.len();
     if n < 3 {
-        return Err(format!(
-            "{n} samples: too short for even one averaging time (3 needed for tau = tau0)"
-        ));
+        return Err(AllanError::TooShort(n));
     }
     let first = y[0];
     if y.iter().all(|&v| v == first) {
-        return Err(
-            "the record is constant: its Allan deviation is zero, there is no noise to analyse"
-                .into(),
-        );
+        return Err(AllanError::Constant);
     }
     let ms = adev::averaging_factors(n, PER_DECADE);
     let taus: Vec<f64> = ms.iter().map(|&m| m as f64 * tau0).collect();
@@ -83,7 +101,8 @@ pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, String> {
 
 /// The sample period of `t` (the median interval), checked: every interval
 /// within [`SAMPLING_TOLERANCE`] of it. The error names the row.
-pub fn sample_period(cols: &Columns, t: &[f64]) -> Result<f64, LabError> {
+pub fn sample_period(series: &RunSeries) -> Result<f64, LabError> {
+    let t = &series.t_s;
     if t.len() < 2 {
         return Ok(1.0);
     }
@@ -92,21 +111,20 @@ pub fn sample_period(cols: &Columns, t: &[f64]) -> Result<f64, LabError> {
     sorted.sort_by(f64::total_cmp);
     let med = sorted[sorted.len() / 2];
     if med.is_nan() || med <= 0.0 {
-        return Err(LabError::Input(format!(
-            "{}: time does not increase",
-            cols.place(1, 0, "t_s")
-        )));
+        return Err(series.time_error(1, "time does not increase"));
     }
     for (k, h) in d.iter_mut().enumerate() {
         if (*h - med).abs() > SAMPLING_TOLERANCE * med {
-            return Err(LabError::Input(format!(
-                "{}: sampling not uniform: interval {} s where the median is {} s (tolerance {} %); \
-                 the Allan variance needs uniform samples",
-                cols.place(k + 1, 0, "t_s"),
-                *h,
-                med,
-                SAMPLING_TOLERANCE * 100.0
-            )));
+            return Err(series.time_error(
+                k + 1,
+                format!(
+                    "sampling not uniform: interval {} s where the median is {} s (tolerance {} %); \
+                     the Allan variance needs uniform samples",
+                    *h,
+                    med,
+                    SAMPLING_TOLERANCE * 100.0
+                ),
+            ));
         }
     }
     Ok(med)
@@ -118,7 +136,7 @@ pub struct AllanArgs {
     #[arg(long)]
     pub data: PathBuf,
     /// The rate column to analyse, deg/s.
-    #[arg(long, default_value = "rate_dps")]
+    #[arg(long, default_value = Column::Rate.name())]
     pub column: String,
     /// Write allan.csv and report.html here.
     #[arg(long)]
@@ -166,37 +184,26 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let cols = Columns::read(&a.data, &["t_s", a.column.as_str()])?;
+    let series = RunSeries::read(&a.data, &a.column)?;
     let read_s = t_start.elapsed().as_secs_f64();
     spinner.set_message("Allan variance");
-    let t = &cols.data[0];
-    let y = &cols.data[1];
-    for k in 1..t.len() {
-        if t[k] <= t[k - 1] {
-            return Err(LabError::Input(format!(
-                "{}: time {} does not increase (previous {})",
-                cols.place(k, 0, "t_s"),
-                t[k],
-                t[k - 1]
-            )));
-        }
-    }
-    let tau0 = sample_period(&cols, t)?;
+    let y = &series.values;
+    let tau0 = sample_period(&series)?;
     let name = a.data.display().to_string();
     let an = analyse(y, tau0)
-        .map_err(|e| LabError::Input(format!("{}: column `{}`: {e}", name, a.column)))?;
+        .map_err(|e| LabError::input(&a.data, format!("column `{}`: {e}", a.column)))?;
     let compute_s = t_start.elapsed().as_secs_f64() - read_s;
     spinner.finish_and_clear();
     let adev: Vec<f64> = an.avar.iter().map(|v| v.sqrt() * DPH).collect();
     let lo: Vec<f64> = an.avar_lo.iter().map(|v| v.sqrt() * DPH).collect();
     let hi: Vec<f64> = an.avar_hi.iter().map(|v| v.sqrt() * DPH).collect();
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| LabError::Io(format!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
         write_csv(&an, &dir.join("allan.csv"))?;
+        let html = dir.join("report.html");
         report(&an, &name, &a.column)
-            .write(&dir.join("report.html"))
-            .map_err(|e| LabError::Io(format!("{}: {e}", dir.join("report.html").display())))?;
+            .write(&html)
+            .map_err(|e| LabError::io(&html, e))?;
     }
     if a.json {
         let mut units = serde_json::Map::new();
@@ -270,28 +277,18 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
 }
 
 fn write_csv(an: &Allan, path: &std::path::Path) -> Result<(), LabError> {
-    let io = |e: std::io::Error| LabError::Io(format!("{}: {e}", path.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    writeln!(
-        w,
-        "tau_s,adev_dph,adev_lo_dph,adev_hi_dph,edf,noise_type,model_adev_dph"
-    )
-    .map_err(io)?;
-    for i in 0..an.taus.len() {
-        writeln!(
-            w,
-            "{},{:.6e},{:.6e},{:.6e},{:.4},{},{:.6e}",
-            sig(an.taus[i]),
-            an.avar[i].sqrt() * DPH,
-            an.avar_lo[i].sqrt() * DPH,
-            an.avar_hi[i].sqrt() * DPH,
-            an.terms.edf[i],
-            NAMES[an.terms.dominant[i]],
-            an.terms.model[i].sqrt() * DPH
-        )
-        .map_err(io)?;
-    }
-    w.flush().map_err(io)
+    let rows: Vec<AllanRow> = (0..an.taus.len())
+        .map(|i| AllanRow {
+            tau_s: an.taus[i],
+            adev_dph: an.avar[i].sqrt() * DPH,
+            adev_lo_dph: an.avar_lo[i].sqrt() * DPH,
+            adev_hi_dph: an.avar_hi[i].sqrt() * DPH,
+            edf: an.terms.edf[i],
+            noise_type: NAMES[an.terms.dominant[i]],
+            model_adev_dph: an.terms.model[i].sqrt() * DPH,
+        })
+        .collect();
+    allan_file::write(path, &rows)
 }
 
 /// The Allan deviation plot (measured points with intervals, the fitted

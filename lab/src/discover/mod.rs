@@ -24,14 +24,14 @@ pub mod select;
 pub mod trials;
 
 use crate::allan;
+use crate::data::residual_file;
+use crate::data::run_file::{Column, RunFile};
 use crate::effects::{Effect, GyroKind, Inputs};
 use crate::error::LabError;
 use crate::model::{Model, ModelEffect};
-use crate::table::Columns;
 use clap::Args;
 use select::{Design, Estimate, Selection, Windows};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The gap's averaging, s.
@@ -64,51 +64,31 @@ pub struct Run {
 
 /// Reads a run file for discovery.
 pub fn read_run(path: &Path) -> Result<Run, LabError> {
-    let (c, opt) = Columns::read_with(
+    let r = RunFile::read_long(
         path,
-        &["t_s", "ref_rate_dps", "rate_dps"],
+        10,
         &[
-            "temp_c",
-            "t_mono_a_c",
-            "t_mono_b_c",
-            "t_case_c",
-            "ref_acc_dps2",
+            Column::Temp,
+            Column::MonoA,
+            Column::MonoB,
+            Column::Case,
+            Column::RefAcc,
         ],
     )?;
-    if c.len() < 10 {
-        return Err(LabError::Input(format!(
-            "{}: {} data rows, at least 10 needed",
-            path.display(),
-            c.len()
-        )));
-    }
-    for k in 1..c.len() {
-        if c.data[0][k] <= c.data[0][k - 1] {
-            return Err(LabError::Input(format!(
-                "{}: time {} does not increase (previous {})",
-                c.place(k, 0, "t_s"),
-                c.data[0][k],
-                c.data[0][k - 1]
-            )));
-        }
-    }
-    let mut c = c;
-    let take = |c: &mut Columns, i: Option<usize>| i.map(|i| std::mem::take(&mut c.data[i]));
-    let temp = take(&mut c, opt[0]);
-    let a = take(&mut c, opt[1]);
-    let b = take(&mut c, opt[2]);
-    let case = take(&mut c, opt[3]);
-    let acc = take(&mut c, opt[4]);
-    let rate = std::mem::take(&mut c.data[2]);
-    let w = std::mem::take(&mut c.data[1]);
-    let t = std::mem::take(&mut c.data[0]);
-    let mono = match (a, b) {
+    let mono = match (r.t_mono_a_c, r.t_mono_b_c) {
         (Some(a), Some(b)) => Some((a, b)),
         _ => None,
     };
     Ok(Run {
-        inputs: Inputs::new(t, w, temp, mono, case, acc),
-        rate,
+        inputs: Inputs::new(
+            r.t_s,
+            r.ref_rate_dps,
+            r.temp_c,
+            mono,
+            r.t_case_c,
+            r.ref_acc_dps2,
+        ),
+        rate: r.rate_dps,
     })
 }
 
@@ -125,7 +105,7 @@ pub struct Discovery {
     pub gyro: GyroKind,
     pub found: Vec<Estimate>,
     pub selection: Selection,
-    pub skipped: Vec<(Effect, &'static [&'static str])>,
+    pub skipped: Vec<(Effect, &'static [Column])>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
     pub windows: Windows,
@@ -238,7 +218,7 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
         .into_iter()
         .filter(|e| e.applies_to(model.gyro) && e.available(inp))
         .collect();
-    let skipped: Vec<(Effect, &'static [&'static str])> = Effect::ALL
+    let skipped: Vec<(Effect, &'static [Column])> = Effect::ALL
         .into_iter()
         .filter(|e| e.applies_to(model.gyro) && !e.available(inp))
         .map(|e| (e, e.needs()))
@@ -319,7 +299,10 @@ pub fn json(d: &Discovery) -> serde_json::Value {
     let skipped: Vec<serde_json::Value> = d
         .skipped
         .iter()
-        .map(|(e, cols)| serde_json::json!({"effect": e.name(), "missing": cols}))
+        .map(|(e, cols)| {
+            let names: Vec<&str> = cols.iter().map(|c| c.name()).collect();
+            serde_json::json!({"effect": e.name(), "missing": names})
+        })
         .collect();
     serde_json::json!({
         "found": found,
@@ -338,47 +321,52 @@ pub fn json(d: &Discovery) -> serde_json::Value {
 pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let t0 = std::time::Instant::now();
     let model = match &a.model {
-        Some(p) => Model::read(p, a.gyro).map_err(LabError::Input)?,
+        Some(p) => Model::read(p, a.gyro)?,
         None => Model::ideal(a.gyro),
     };
     let data = read_run(&a.data)?;
     // The model's own effects must be computable on this run.
     if let Some((e, cols)) = model.missing_inputs(&data.inputs).first() {
-        return Err(LabError::Input(format!(
-            "{}: the model's effect `{}` needs column(s) {} that this run lacks",
-            a.data.display(),
-            e.name(),
-            cols.iter()
-                .map(|c| format!("`{c}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
+        return Err(LabError::input(
+            &a.data,
+            format!(
+                "the model's effect `{}` needs column(s) {} that this run lacks",
+                e.name(),
+                cols.iter()
+                    .map(|c| format!("`{}`", c.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
     }
     let d = discover(&model, &data);
-    std::fs::create_dir_all(&a.out)
-        .map_err(|e| LabError::Io(format!("{}: {e}", a.out.display())))?;
+    std::fs::create_dir_all(&a.out).map_err(|e| LabError::io(&a.out, e))?;
     let names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
-    d.model_after
-        .write(
-            &a.out.join("model.toml"),
-            &format!(
-                "gyro-lab discover on {}: the model{} with {} added",
-                a.data.display(),
-                a.model
-                    .as_ref()
-                    .map_or(" (ideal)".into(), |p| format!(" {}", p.display())),
-                if names.is_empty() {
-                    "nothing".to_owned()
-                } else {
-                    names.join(", ")
-                }
-            ),
-        )
-        .map_err(LabError::Io)?;
-    write_residual(&a.out.join("residual.csv"), &data.inputs.t, &d)?;
+    d.model_after.write(
+        &a.out.join("model.toml"),
+        &format!(
+            "gyro-lab discover on {}: the model{} with {} added",
+            a.data.display(),
+            a.model
+                .as_ref()
+                .map_or(" (ideal)".into(), |p| format!(" {}", p.display())),
+            if names.is_empty() {
+                "nothing".to_owned()
+            } else {
+                names.join(", ")
+            }
+        ),
+    )?;
+    residual_file::write(
+        &a.out.join("residual.csv"),
+        &data.inputs.t,
+        &d.residual_before,
+        &d.residual_after,
+    )?;
+    let html = a.out.join("report.html");
     report::report(&d, &data, &a.data)
-        .write(&a.out.join("report.html"))
-        .map_err(|e| LabError::Io(format!("{}: {e}", a.out.join("report.html").display())))?;
+        .write(&html)
+        .map_err(|e| LabError::io(&html, e))?;
     if a.json {
         let mut j = json(&d);
         j["elapsed_s"] = t0.elapsed().as_secs_f64().into();
@@ -405,7 +393,8 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
         );
     }
     for (e, cols) in &d.skipped {
-        println!("skipped {}: the run has no {}", e.name(), cols.join(", "));
+        let names: Vec<&str> = cols.iter().map(|c| c.name()).collect();
+        println!("skipped {}: the run has no {}", e.name(), names.join(", "));
     }
     if d.found.is_empty() && d.selection.ambiguous.is_empty() {
         println!("nothing is missing: no effect of the library beats the noise");
@@ -446,19 +435,4 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
         a.out.join("model.toml").display()
     );
     Ok(())
-}
-
-fn write_residual(path: &Path, t: &[f64], d: &Discovery) -> Result<(), LabError> {
-    let io = |e: std::io::Error| LabError::Io(format!("{}: {e}", path.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    writeln!(w, "t_s,residual_before_dps,residual_after_dps").map_err(io)?;
-    for k in 0..t.len() {
-        writeln!(
-            w,
-            "{},{:.9e},{:.9e}",
-            t[k], d.residual_before[k], d.residual_after[k]
-        )
-        .map_err(io)?;
-    }
-    w.flush().map_err(io)
 }

@@ -183,7 +183,10 @@ pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
             "Skipped (the run lacks their inputs): {}.",
             d.skipped
                 .iter()
-                .map(|(e, c)| format!("{} ({})", e.name(), c.join(", ")))
+                .map(|(e, c)| {
+                    let names: Vec<&str> = c.iter().map(|c| c.name()).collect();
+                    format!("{} ({})", e.name(), names.join(", "))
+                })
                 .collect::<Vec<_>>()
                 .join("; ")
         ));

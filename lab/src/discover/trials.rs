@@ -5,6 +5,8 @@
 //! `gyro-lab simulate run` writes them; the discovery bench and tests draw
 //! them.
 
+use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
+use crate::data::run_file::{Column, RunWriter};
 use crate::effects::{GyroKind, Inputs};
 use crate::error::LabError;
 use crate::model::Model;
@@ -12,7 +14,6 @@ use gyro_sim::{Chamber, ChamberParams, CoilThermal, NoiseParams, RateNoise};
 use rand_core::{RngCore, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Test profiles.
@@ -231,44 +232,46 @@ pub fn generate(
     }
 }
 
-/// Writes a run file.
-pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> std::io::Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    for l in comment.lines() {
-        writeln!(f, "# {l}")?;
-    }
+/// Writes a run file: the required columns, then those the profile has.
+pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> Result<(), LabError> {
     let inp = &run.inputs;
-    let mut head = vec!["t_s", "ref_rate_dps", "rate_dps"];
+    let mut cols = vec![
+        (Column::Time, Shortest),
+        (Column::RefRate, Fixed(9)),
+        (Column::Rate, Exp(12)),
+    ];
     if inp.temp.is_some() {
-        head.push("temp_c");
+        cols.push((Column::Temp, Fixed(4)));
     }
     if run.mono.is_some() {
-        head.extend(["t_mono_a_c", "t_mono_b_c"]);
+        cols.extend([(Column::MonoA, Fixed(4)), (Column::MonoB, Fixed(4))]);
     }
     if run.case.is_some() {
-        head.push("t_case_c");
+        cols.push((Column::Case, Fixed(4)));
     }
     if run.acc_column {
-        head.push("ref_acc_dps2");
+        cols.push((Column::RefAcc, Fixed(6)));
     }
-    writeln!(f, "{}", head.join(","))?;
+    let mut w = RunWriter::create(path, comment, &cols)?;
+    let mut row = Vec::with_capacity(cols.len());
     for k in 0..inp.len() {
-        write!(f, "{},{:.9},{:.12e}", inp.t[k], inp.w[k], run.rate[k])?;
+        row.clear();
+        row.extend([inp.t[k], inp.w[k], run.rate[k]]);
         if let Some(tc) = &inp.temp {
-            write!(f, ",{:.4}", tc[k])?;
+            row.push(tc[k]);
         }
         if let Some((a, b)) = &run.mono {
-            write!(f, ",{:.4},{:.4}", a[k], b[k])?;
+            row.extend([a[k], b[k]]);
         }
         if let Some(c) = &run.case {
-            write!(f, ",{:.4}", c[k])?;
+            row.push(c[k]);
         }
         if run.acc_column {
-            write!(f, ",{:.6}", inp.acc[k])?;
+            row.push(inp.acc[k]);
         }
-        writeln!(f)?;
+        w.row(&row)?;
     }
-    f.flush()
+    w.finish()
 }
 
 #[derive(clap::Args, Debug, Clone)]
@@ -298,7 +301,7 @@ pub struct SimulateRunArgs {
 }
 
 pub fn simulate(a: &SimulateRunArgs) -> Result<(), LabError> {
-    let model = Model::read(&a.model, a.profile.gyro()).map_err(LabError::Input)?;
+    let model = Model::read(&a.model, a.profile.gyro())?;
     let (dt0, dur0) = a.profile.default_timing();
     let dt = a.dt_s.unwrap_or(dt0);
     let dur = a.duration_s.unwrap_or(dur0);
@@ -327,8 +330,7 @@ pub fn simulate(a: &SimulateRunArgs) -> Result<(), LabError> {
             noise.arw_dpsh,
             noise.bias_instability_dph
         ),
-    )
-    .map_err(|e| LabError::Io(format!("{}: {e}", a.out.display())))?;
+    )?;
     let j = serde_json::json!({"rows": run.inputs.len(), "out": a.out});
     if a.json {
         println!("{j}");

@@ -3,8 +3,8 @@
 pub mod estimate;
 pub mod fringe_sim;
 
+use crate::data::fringe_file::{FringeFile, FringeWriter};
 use crate::error::LabError;
-use crate::table::Table;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -37,16 +37,22 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
             )));
         }
     }
-    let table = Table::read(&a.data)?;
-    let t = table.time(64)?;
-    let s = table.column("signal")?;
-    let q = table.column_opt("signal_q")?;
-    let r = estimate::lock_in(&t, &s, q.as_deref(), a.pulses_per_deg, a.input_rate_dps)
-        .map_err(|e| LabError::Input(format!("{}: {e}", a.data.display())))?;
+    let f = FringeFile::read(&a.data, 64)?;
+    let r = estimate::lock_in(
+        &f.t_s,
+        &f.signal,
+        f.signal_q.as_deref(),
+        a.pulses_per_deg,
+        a.input_rate_dps,
+    )
+    .map_err(|e| LabError::input(&a.data, e.to_string()))?;
     if a.json {
         println!(
             "{}",
-            serde_json::to_string(&r).map_err(|e| LabError::Io(e.to_string()))?
+            serde_json::to_string(&r).map_err(|e| LabError::Io {
+                file: None,
+                msg: e.to_string()
+            })?
         );
     } else {
         println!(
@@ -142,32 +148,25 @@ pub fn simulate(a: &LockinSimArgs) -> Result<(), LabError> {
         ..Default::default()
     };
     let f = p.simulate();
-    let io = |e: std::io::Error| LabError::Io(format!("{}: {e}", a.out.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&a.out).map_err(io)?);
-    use std::io::Write;
-    writeln!(
-        w,
-        "# gyro-lab simulate lockin: K {} /deg, Omega_I {} deg/s, Omega_L {} deg/s, beat {:.6} Hz",
-        p.pulses_per_deg,
-        p.input_rate_dps,
-        p.lock_in_dps,
-        p.beat_hz()
-    )
-    .map_err(io)?;
-    writeln!(
-        w,
-        "t_s,signal{}",
-        if a.quadrature { ",signal_q" } else { "" }
-    )
-    .map_err(io)?;
+    let mut w = FringeWriter::create(
+        &a.out,
+        &format!(
+            "gyro-lab simulate lockin: K {} /deg, Omega_I {} deg/s, Omega_L {} deg/s, beat {:.6} Hz",
+            p.pulses_per_deg,
+            p.input_rate_dps,
+            p.lock_in_dps,
+            p.beat_hz()
+        ),
+        a.quadrature,
+    )?;
     for k in 0..f.t.len() {
         if a.quadrature {
-            writeln!(w, "{:.8},{:.6e},{:.6e}", f.t[k], f.s[k], f.q[k]).map_err(io)?;
+            w.row(&[f.t[k], f.s[k], f.q[k]])?;
         } else {
-            writeln!(w, "{:.8},{:.6e}", f.t[k], f.s[k]).map_err(io)?;
+            w.row(&[f.t[k], f.s[k]])?;
         }
     }
-    w.flush().map_err(io)?;
+    w.finish()?;
     if a.json {
         println!(
             "{}",
@@ -249,7 +248,10 @@ pub fn bench_run(a: &LockinBenchArgs) -> Result<(), LabError> {
         }
         out.insert(
             key.into(),
-            serde_json::to_value(&rows).map_err(|e| LabError::Io(e.to_string()))?,
+            serde_json::to_value(&rows).map_err(|e| LabError::Io {
+                file: None,
+                msg: e.to_string(),
+            })?,
         );
     }
     println!("{}", serde_json::Value::Object(out));

@@ -116,7 +116,9 @@ pub fn run(a: &BenchArgs) -> Result<(), LabError> {
         );
         b
     };
-    let fail = |what: &str, e: String| LabError::Input(format!("bench scale-factor: {what}: {e}"));
+    let fail = |what: &str, e: fit::SfFitError| {
+        LabError::Bench(format!("bench scale-factor: {what}: {e}"))
+    };
     let (mut knee_err, mut knee_w, mut lag) = (vec![], vec![], vec![]);
     let (mut one_knee, mut covers, mut lag_covers, mut bracketed, mut no_knee_ok) = (0, 0, 0, 0, 0);
     let (mut raw, mut mp, mut cont) = (vec![], vec![], vec![]);
@@ -227,7 +229,10 @@ pub fn run(a: &BenchArgs) -> Result<(), LabError> {
     }
     println!(
         "{}",
-        serde_json::to_string(&j).map_err(|e| LabError::Io(e.to_string()))?
+        serde_json::to_string(&j).map_err(|e| LabError::Io {
+            file: None,
+            msg: e.to_string()
+        })?
     );
     Ok(())
 }

@@ -189,10 +189,61 @@ pub struct BiasModel {
     pub slope_dph_per_c: Est,
 }
 
+/// Which calibration a run is: it decides the fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum FitMethod {
+    /// Constant rates while the chamber sweeps.
+    #[serde(rename = "continuous")]
+    Continuous,
+    /// Temperature plateaus, each with a rate sequence.
+    #[serde(rename = "multi-point")]
+    MultiPoint,
+}
+
+impl FitMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            FitMethod::Continuous => "continuous",
+            FitMethod::MultiPoint => "multi-point",
+        }
+    }
+}
+
+impl std::fmt::Display for FitMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why a run could not be fitted.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SfFitError {
+    /// More temperature plateaus than the table has nodes.
+    TooManyPlateaus(usize),
+    /// A plateau's rate sequence could not be fitted.
+    Plateau,
+    /// The continuous model is singular on this run.
+    Singular,
+}
+
+impl std::fmt::Display for SfFitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SfFitError::TooManyPlateaus(n) => write!(
+                f,
+                "{n} temperature plateaus: the table holds at most {MAX_NODES}"
+            ),
+            SfFitError::Plateau => f.write_str("a plateau's rate sequence could not be fitted"),
+            SfFitError::Singular => {
+                f.write_str("the scale-factor model could not be fitted (singular data)")
+            }
+        }
+    }
+}
+
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SfFit {
-    /// "continuous" or "multi-point".
-    pub method: &'static str,
+    pub method: FitMethod,
     pub knees: Vec<Interval>,
     pub segments: Vec<Segment>,
     #[serde(skip)]
@@ -448,7 +499,7 @@ fn refine(m: &Model, c: &mut Candidate, lo: f64, hi: f64) {
 }
 
 /// The fit of a continuous-rotation run.
-pub fn fit_continuous(inp: &SfInput) -> Result<SfFit, String> {
+pub fn fit_continuous(inp: &SfInput) -> Result<SfFit, SfFitError> {
     let all: Vec<usize> = (0..inp.t.len()).collect();
     let rot = rotating(&inp.w);
     let signs: std::collections::BTreeSet<i8> = inp
@@ -515,7 +566,7 @@ pub fn fit_continuous(inp: &SfInput) -> Result<SfFit, String> {
     let richest = &models[models.len() - 1];
     let rf = m
         .fit(richest.lag, &richest.knees)
-        .ok_or("the scale-factor model could not be fitted (singular data)")?;
+        .ok_or(SfFitError::Singular)?;
     let z: Vec<f64> = (0..nb).map(|i| rf.resid[i] * m.b.n[i].sqrt()).collect();
     let (mut num, mut den) = (0.0, 0.0);
     for i in 0..nb {
@@ -617,9 +668,7 @@ pub fn fit_continuous(inp: &SfInput) -> Result<SfFit, String> {
     };
     let (lag_lo, lag_hi) = profile_interval(prof_lag, c.lag, c.sse, thr, 0.5, (0.0, 1000.0));
 
-    let f = m
-        .fit(c.lag, &c.knees)
-        .ok_or("the scale-factor model could not be fitted (singular data)")?;
+    let f = m.fit(c.lag, &c.knees).ok_or(SfFitError::Singular)?;
     let v = phi * var;
     let nk = c.knees.len();
     // s(T) as a . coef.
@@ -678,7 +727,7 @@ pub fn fit_continuous(inp: &SfInput) -> Result<SfFit, String> {
             .into(),
     );
     Ok(SfFit {
-        method: "continuous",
+        method: FitMethod::Continuous,
         knees,
         segments,
         table,
@@ -859,16 +908,13 @@ fn plateau_chi2(pts: &[Plateau], knee: Option<f64>) -> f64 {
 pub fn fit_multipoint(
     inp: &SfInput,
     groups: &[Vec<usize>],
-) -> Result<(SfFit, Vec<Plateau>), String> {
+) -> Result<(SfFit, Vec<Plateau>), SfFitError> {
     if groups.len() > MAX_NODES {
-        return Err(format!(
-            "{} temperature plateaus: the table holds at most {MAX_NODES}",
-            groups.len()
-        ));
+        return Err(SfFitError::TooManyPlateaus(groups.len()));
     }
     let mut pts: Vec<Plateau> = vec![];
     for g in groups {
-        pts.push(plateau_fit(inp, g).ok_or("a plateau's rate sequence could not be fitted")?);
+        pts.push(plateau_fit(inp, g).ok_or(SfFitError::Plateau)?);
     }
     pts.sort_by(|a, b| a.temp_c.total_cmp(&b.temp_c));
     let np = pts.len();
@@ -982,7 +1028,7 @@ pub fn fit_multipoint(
     ];
     Ok((
         SfFit {
-            method: "multi-point",
+            method: FitMethod::MultiPoint,
             knees,
             segments,
             table,

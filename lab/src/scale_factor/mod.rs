@@ -6,10 +6,11 @@ pub mod bench;
 pub mod fit;
 pub mod sim;
 
+use crate::data::csv_writer::CellFormat::Fixed;
+use crate::data::run_file::{Column, RunFile, RunWriter};
 use crate::error::LabError;
-use crate::table::Table;
 use clap::Args;
-use fit::{SfFit, SfInput};
+use fit::{SfFit, SfFitError, SfInput};
 use gyro_coeffs::file::CoeffFile;
 use gyro_coeffs::ScaleFactorTable;
 use gyro_sp::fog::scale_factor::ScaleFactorComp;
@@ -22,7 +23,10 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 fn json_line<T: serde::Serialize>(v: &T) -> Result<(), LabError> {
     println!(
         "{}",
-        serde_json::to_string(v).map_err(|e| LabError::Io(e.to_string()))?
+        serde_json::to_string(v).map_err(|e| LabError::Io {
+            file: None,
+            msg: e.to_string()
+        })?
     );
     Ok(())
 }
@@ -150,16 +154,41 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), LabError> {
     let run = sim::simulate(&a.test(), &a.rig());
     let truth = a.rig().truth;
     let knees: Vec<f64> = truth.knees[..truth.n_knees].iter().map(|k| k.0).collect();
-    sim::write(
-        &run,
+    let mut w = RunWriter::create(
         &a.out,
         &format!(
             "gyro-lab simulate scale-factor: {:?} test, seed {}; truth: knees at {:?} degC, sensor lag {} s\n\
-             temp_c is the coil sensor; t_coil_true_c and sf_true_ppm are the truth (not used by the fit)",
-            a.test, a.seed, knees, a.sensor_lag_s
+             {} is the coil sensor; {} and {} are the truth (not used by the fit)",
+            a.test,
+            a.seed,
+            knees,
+            a.sensor_lag_s,
+            Column::Temp.name(),
+            Column::TrueCoilTemp.name(),
+            Column::TrueScaleFactor.name()
         ),
-    )
-    .map_err(|e| LabError::Io(format!("{}: {e}", a.out.display())))?;
+        &[
+            (Column::Time, Fixed(3)),
+            (Column::RefRate, Fixed(6)),
+            (Column::Rate, Fixed(10)),
+            (Column::Temp, Fixed(4)),
+            (Column::AirTemp, Fixed(3)),
+            (Column::TrueCoilTemp, Fixed(4)),
+            (Column::TrueScaleFactor, Fixed(4)),
+        ],
+    )?;
+    for k in 0..run.t_s.len() {
+        w.row(&[
+            run.t_s[k],
+            run.ref_rate_dps[k],
+            run.rate_dps[k],
+            run.temp_c[k],
+            run.air_c[k],
+            run.coil_true_c[k],
+            run.sf_true_ppm[k],
+        ])?;
+    }
+    w.finish()?;
     let hours = run.t_s.last().copied().unwrap_or(0.0) / 3600.0;
     if a.json {
         json_line(&serde_json::json!({
@@ -178,20 +207,20 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), LabError> {
 /// A run file read for the scale-factor tools, checked: `t_s`,
 /// `ref_rate_dps`, `rate_dps`, `temp_c`; rotation present; a temperature
 /// span the model can use.
-pub fn read_run(path: &std::path::Path) -> Result<(Table, SfInput), LabError> {
-    let tab = Table::read(path)?;
-    let t = tab.time(30)?;
-    let w = tab.column("ref_rate_dps")?;
-    let y = tab.column("rate_dps")?;
-    let temp = tab.column("temp_c")?;
-    let rot = fit::rotating(&w);
+pub fn read_run(path: &std::path::Path) -> Result<SfInput, LabError> {
+    let (text, [temp]) = RunFile::read(path, 30, [Column::Temp])?;
+    let (t, w, y) = (&text.run.t_s, &text.run.ref_rate_dps, &text.run.rate_dps);
+    let rot = fit::rotating(w);
     if rot.len() < 30 {
-        return Err(LabError::Input(format!(
-            "{}: no rotation: {} rows with |ref_rate_dps| >= {} deg/s, at least 30 needed to measure a scale factor",
-            tab.column_place("ref_rate_dps"),
-            rot.len(),
-            fit::MIN_RATE_DPS
-        )));
+        return Err(text.column_error(
+            Column::RefRate,
+            format!(
+                "no rotation: {} rows with |{}| >= {} deg/s, at least 30 needed to measure a scale factor",
+                rot.len(),
+                Column::RefRate.name(),
+                fit::MIN_RATE_DPS
+            ),
+        ));
     }
     let (lo, hi) = rot
         .iter()
@@ -200,15 +229,16 @@ pub fn read_run(path: &std::path::Path) -> Result<(Table, SfInput), LabError> {
             (a.min(x), b.max(x))
         });
     if hi - lo < fit::MIN_SPAN_C {
-        return Err(LabError::Input(format!(
-            "{}: temperature span {:.2} degC over the rotating rows; the scale-factor-over-temperature model needs at least {} degC",
-            tab.column_place("temp_c"),
-            hi - lo,
-            fit::MIN_SPAN_C
-        )));
+        return Err(text.column_error(
+            Column::Temp,
+            format!(
+                "temperature span {:.2} degC over the rotating rows; the scale-factor-over-temperature model needs at least {} degC",
+                hi - lo,
+                fit::MIN_SPAN_C
+            ),
+        ));
     }
-    let inp = fit::prepare(&t, &w, &y, &temp);
-    Ok((tab, inp))
+    Ok(fit::prepare(t, w, y, &temp))
 }
 
 #[derive(Args, Debug, Clone)]
@@ -249,7 +279,7 @@ struct TableJson {
 }
 
 /// Fits either kind of run.
-pub fn fit_run_data(inp: &SfInput) -> Result<(SfFit, Option<Vec<fit::Plateau>>), String> {
+pub fn fit_run_data(inp: &SfInput) -> Result<(SfFit, Option<Vec<fit::Plateau>>), SfFitError> {
     let rot = fit::rotating(&inp.w);
     match fit::plateaus(inp, &rot) {
         Some(groups) => fit::fit_multipoint(inp, &groups).map(|(f, p)| (f, Some(p))),
@@ -258,21 +288,24 @@ pub fn fit_run_data(inp: &SfInput) -> Result<(SfFit, Option<Vec<fit::Plateau>>),
 }
 
 pub fn fit_run(a: &FitArgs) -> Result<(), LabError> {
-    let (_, inp) = read_run(&a.data)?;
+    let inp = read_run(&a.data)?;
     let name = a.data.display().to_string();
-    let (f, plateaus) = fit_run_data(&inp).map_err(|e| LabError::Input(format!("{name}: {e}")))?;
+    let (f, plateaus) = fit_run_data(&inp).map_err(|e| LabError::input(&a.data, e.to_string()))?;
     f.table.check().map_err(|e| {
-        LabError::Input(format!(
-            "{name}: the fitted table is out of the firmware's range ({e:?}): {:?}",
-            f.table
-        ))
+        LabError::input(
+            &a.data,
+            format!(
+                "the fitted table is out of the firmware's range ({e:?}): {:?}",
+                f.table
+            ),
+        )
     })?;
     let n = f.table.n;
     let record = f.table.to_record();
     let crc = format!("0x{:08x}", gyro_coeffs::record::crc_of(&record));
     let mut info = toml::Table::new();
     info.insert("data".into(), name.clone().into());
-    info.insert("method".into(), f.method.into());
+    info.insert("method".into(), f.method.name().into());
     info.insert(
         "knees_c".into(),
         toml::Value::Array(f.knees.iter().map(|k| k.value.into()).collect()),
@@ -287,7 +320,7 @@ pub fn fit_run(a: &FitArgs) -> Result<(), LabError> {
          coil temperature = sensor + sensor_lag_s * d(sensor)/dt. Load with `gyro-lab compensate` or build the\n\
          firmware with FOG_SF_COEFFS=<this file>.",
     )
-    .map_err(LabError::Io)?;
+    .map_err(|e| LabError::coeffs_io(&a.out, &e))?;
     if a.json {
         return json_line(&FitJson {
             knees_c: f.knees.iter().map(|k| k.value).collect(),
@@ -426,16 +459,13 @@ pub fn compensate_run(
     a: &crate::thermal::CompensateArgs,
     table: &ScaleFactorTable,
 ) -> Result<(), LabError> {
-    let tab = Table::read(&a.data)?;
-    let t = tab.time(2)?;
-    let w = tab.column("ref_rate_dps")?;
-    let y = tab.column("rate_dps")?;
-    let temp = tab.column("temp_c")?;
-    let (comp, flags) = compensate_rows(table, &t, &y, &temp);
-    tab.write_with(&a.out, &[("rate_comp_dps", &comp)])?;
-    let err = |v: &[f64]| -> Vec<f64> { v.iter().zip(&w).map(|(a, b)| a - b).collect() };
-    let (raw, raw_se, _) = fit::window_rms_ppm(&t, &w, &err(&y), fit::RESIDUAL_WINDOW_S);
-    let (c, c_se, m) = fit::window_rms_ppm(&t, &w, &err(&comp), fit::RESIDUAL_WINDOW_S);
+    let (text, [temp]) = RunFile::read(&a.data, 2, [Column::Temp])?;
+    let (t, w, y) = (&text.run.t_s, &text.run.ref_rate_dps, &text.run.rate_dps);
+    let (comp, flags) = compensate_rows(table, t, y, &temp);
+    text.write_back(&a.out, &[(Column::CompensatedRate, &comp)])?;
+    let err = |v: &[f64]| -> Vec<f64> { v.iter().zip(w).map(|(a, b)| a - b).collect() };
+    let (raw, raw_se, _) = fit::window_rms_ppm(t, w, &err(y), fit::RESIDUAL_WINDOW_S);
+    let (c, c_se, m) = fit::window_rms_ppm(t, w, &err(&comp), fit::RESIDUAL_WINDOW_S);
     let s = CompensateJson {
         raw_ppm: raw,
         raw_ppm_se: raw_se,

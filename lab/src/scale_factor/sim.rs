@@ -265,30 +265,3 @@ pub fn simulate(test: &Test, p: &RigParams) -> Run {
     }
     run
 }
-
-/// Writes a run file (docs/interfaces.md) with the truth columns.
-pub fn write(run: &Run, path: &std::path::Path, comment: &str) -> std::io::Result<()> {
-    use std::io::Write;
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    for l in comment.lines() {
-        writeln!(w, "# {l}")?;
-    }
-    writeln!(
-        w,
-        "t_s,ref_rate_dps,rate_dps,temp_c,t_air_c,t_coil_true_c,sf_true_ppm"
-    )?;
-    for k in 0..run.t_s.len() {
-        writeln!(
-            w,
-            "{:.3},{:.6},{:.10},{:.4},{:.3},{:.4},{:.4}",
-            run.t_s[k],
-            run.ref_rate_dps[k],
-            run.rate_dps[k],
-            run.temp_c[k],
-            run.air_c[k],
-            run.coil_true_c[k],
-            run.sf_true_ppm[k]
-        )?;
-    }
-    w.flush()
-}

@@ -3,10 +3,11 @@
 //! model is `gyro_sim::Chamber` (also inside the qemu firmware); this adds
 //! the chamber profile and the Earth-rate component of the orientation.
 
+use crate::data::csv_writer::CellFormat::Fixed;
+use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
 use clap::{Args, ValueEnum};
 use gyro_sim::{Chamber, ChamberParams};
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Earth rate, deg/h.
@@ -133,19 +134,23 @@ pub fn simulate(a: &ChamberArgs) -> Result<(), LabError> {
     let reference = earth_component_dps(a.azimuth_deg, a.elevation_deg, a.latitude_deg);
     let air0 = air_temperature(a.profile, a.soak_c, 0.0);
     let mut ch = Chamber::new(p, air0);
-    let io = |e: std::io::Error| LabError::Io(format!("{}: {e}", a.out.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&a.out).map_err(io)?);
-    writeln!(
-        w,
-        "# gyro-lab simulate chamber: profile {:?}, axis azimuth {} deg elevation {} deg, latitude {} deg",
-        a.profile, a.azimuth_deg, a.elevation_deg, a.latitude_deg
-    )
-    .map_err(io)?;
-    writeln!(
-        w,
-        "t_s,ref_rate_dps,rate_dps,t_mono_a_c,t_mono_b_c,t_case_c,t_air_c,bias_true_dph"
-    )
-    .map_err(io)?;
+    let mut w = RunWriter::create(
+        &a.out,
+        &format!(
+            "gyro-lab simulate chamber: profile {:?}, axis azimuth {} deg elevation {} deg, latitude {} deg",
+            a.profile, a.azimuth_deg, a.elevation_deg, a.latitude_deg
+        ),
+        &[
+            (Column::Time, Fixed(3)),
+            (Column::RefRate, Fixed(9)),
+            (Column::Rate, Fixed(9)),
+            (Column::MonoA, Fixed(4)),
+            (Column::MonoB, Fixed(4)),
+            (Column::Case, Fixed(4)),
+            (Column::AirTemp, Fixed(3)),
+            (Column::TrueBias, Fixed(6)),
+        ],
+    )?;
     let n = (dur / a.dt_s).round() as u64;
     let mut last = 0i64;
     for k in 0..n {
@@ -154,14 +159,18 @@ pub fn simulate(a: &ChamberArgs) -> Result<(), LabError> {
         let s = ch.step(a.dt_s, air, reference);
         let rate = (s.counts - last) as f64 / p.counts_per_deg / a.dt_s;
         last = s.counts;
-        writeln!(
-            w,
-            "{:.3},{:.9},{:.9},{:.4},{:.4},{:.4},{:.3},{:.6}",
-            s.t_s, reference, rate, s.t_mono_a_c, s.t_mono_b_c, s.t_case_c, air, s.bias_true_dph
-        )
-        .map_err(io)?;
+        w.row(&[
+            s.t_s,
+            reference,
+            rate,
+            s.t_mono_a_c,
+            s.t_mono_b_c,
+            s.t_case_c,
+            air,
+            s.bias_true_dph,
+        ])?;
     }
-    w.flush().map_err(io)?;
+    w.finish()?;
     if a.json {
         println!(
             "{}",

@@ -3,8 +3,8 @@
 pub mod chamber;
 pub mod fit;
 
+use crate::data::run_file::{Column, RunFile, RunText};
 use crate::error::LabError;
-use crate::table::Table;
 use clap::Args;
 use fit::{
     coefficient_se, fit_thermal, noise_floor_100s, std_of_means, std_se, CubicModel, ThermalData,
@@ -15,30 +15,24 @@ use gyro_sp::rlg::{compensate_rate_ndps, ThermalCoeffs};
 use std::path::{Path, PathBuf};
 
 /// A chamber run read from a run file.
-pub fn read_run(path: &Path) -> Result<(Table, ThermalData, Vec<f64>), LabError> {
-    let tab = Table::read(path)?;
-    let t = tab.time(200)?;
-    let reference = tab.column("ref_rate_dps")?;
-    let rate = tab.column("rate_dps")?;
-    let a = tab.column("t_mono_a_c")?;
-    let b = tab.column("t_mono_b_c")?;
-    let case = tab.column("t_case_c")?;
-    let drift_dph = rate
+pub fn read_run(path: &Path) -> Result<(RunText, ThermalData), LabError> {
+    let (text, [a, b, case]) =
+        RunFile::read(path, 200, [Column::MonoA, Column::MonoB, Column::Case])?;
+    let r = &text.run;
+    let drift_dph = r
+        .rate_dps
         .iter()
-        .zip(&reference)
+        .zip(&r.ref_rate_dps)
         .map(|(r, w)| (r - w) * 3600.0)
         .collect();
-    Ok((
-        tab,
-        ThermalData {
-            t,
-            a,
-            b,
-            case,
-            drift_dph,
-        },
-        rate,
-    ))
+    let d = ThermalData {
+        t: r.t_s.clone(),
+        a,
+        b,
+        case,
+        drift_dph,
+    };
+    Ok((text, d))
 }
 
 /// B_TC per row by the firmware's own fixed-point compensation (thermal.rs),
@@ -101,21 +95,21 @@ pub struct FitSummary {
 }
 
 pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
-    let (_, d, _) = read_run(&a.data)?;
+    let (_, d) = read_run(&a.data)?;
     let (c, resid) = fit_thermal(&d).ok_or_else(|| {
-        LabError::Input(format!(
-            "{}: the thermal model could not be fitted (singular data)",
-            a.data.display()
-        ))
+        LabError::input(
+            &a.data,
+            "the thermal model could not be fitted (singular data)",
+        )
     })?;
     c.check().map_err(|e| {
-        LabError::Input(format!(
-            "{}: fitted coefficients out of the firmware's range ({e:?}): {c:?}",
-            a.data.display()
-        ))
+        LabError::input(
+            &a.data,
+            format!("fitted coefficients out of the firmware's range ({e:?}): {c:?}"),
+        )
     })?;
     let cubic = CubicModel::fit(&d.a, &d.drift_dph)
-        .ok_or_else(|| LabError::Input(format!("{}: cubic fit failed", a.data.display())))?;
+        .ok_or_else(|| LabError::input(&a.data, "cubic fit failed"))?;
     let cubic_res: Vec<f64> = d
         .drift_dph
         .iter()
@@ -162,11 +156,14 @@ pub fn fit_run(a: &FitThermalArgs) -> Result<(), LabError> {
          B = bias0 + k1*dT + k2*grad(dT) + k3*dT^2 + k4*T_K + k5*(1 - exp(-t/tau_warm)), deg/h;\n\
          dT = t_mono_a - t_mono_b. Load with `gyro-lab compensate` or build the firmware with RLG_COEFFS=<this file>.",
     )
-    .map_err(LabError::Io)?;
+    .map_err(|e| LabError::coeffs_io(&a.out, &e))?;
     if a.json {
         println!(
             "{}",
-            serde_json::to_string(&s).map_err(|e| LabError::Io(e.to_string()))?
+            serde_json::to_string(&s).map_err(|e| LabError::Io {
+                file: None,
+                msg: e.to_string()
+            })?
         );
     } else {
         let v = s.coefficients.values();
@@ -239,7 +236,8 @@ pub struct CompensateSummary {
 
 /// `gyro-lab compensate`: either kind of coefficient file, by its `kind`.
 pub fn compensate_run(a: &CompensateArgs) -> Result<(), LabError> {
-    let (_, coeffs) = gyro_coeffs::file::read(&a.coeffs).map_err(LabError::Input)?;
+    let (_, coeffs) =
+        gyro_coeffs::file::read(&a.coeffs).map_err(|e| LabError::coeffs_input(&a.coeffs, &e))?;
     match coeffs {
         gyro_coeffs::file::Coeffs::RlgThermal(c) => compensate_rlg(a, &c),
         gyro_coeffs::file::Coeffs::FogScaleFactor(t) => crate::scale_factor::compensate_run(a, &t),
@@ -248,27 +246,28 @@ pub fn compensate_run(a: &CompensateArgs) -> Result<(), LabError> {
 
 fn compensate_rlg(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
     let c = *c;
-    let (tab, d, rate) = read_run(&a.data)?;
+    let (text, d) = read_run(&a.data)?;
     let (bias, flags) = firmware_bias(&c, &d);
-    let comp: Vec<f64> = rate
+    let comp: Vec<f64> = text
+        .run
+        .rate_dps
         .iter()
         .zip(&bias)
         .map(|(r, b)| compensate_rate_ndps((r * 1e9).round() as i64, *b) as f64 * 1e-9)
         .collect();
-    let reference = tab.column("ref_rate_dps")?;
     let comp_drift: Vec<f64> = comp
         .iter()
-        .zip(&reference)
+        .zip(&text.run.ref_rate_dps)
         .map(|(r, w)| (r - w) * 3600.0)
         .collect();
-    tab.write_with(&a.out, &[("rate_comp_dps", &comp)])?;
+    text.write_back(&a.out, &[(Column::CompensatedRate, &comp)])?;
     let floor = noise_floor_100s(&d.t, &d.drift_dph);
     let comp_std = std_of_means(&d.t, &comp_drift, 100.0);
     let cubic_std = match &a.cubic_from {
         Some(p) => {
-            let (_, dc, _) = read_run(p)?;
+            let (_, dc) = read_run(p)?;
             let m = CubicModel::fit(&dc.a, &dc.drift_dph)
-                .ok_or_else(|| LabError::Input(format!("{}: cubic fit failed", p.display())))?;
+                .ok_or_else(|| LabError::input(p, "cubic fit failed"))?;
             let r: Vec<f64> = d
                 .drift_dph
                 .iter()
@@ -295,7 +294,10 @@ fn compensate_rlg(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError>
     if a.json {
         println!(
             "{}",
-            serde_json::to_string(&s).map_err(|e| LabError::Io(e.to_string()))?
+            serde_json::to_string(&s).map_err(|e| LabError::Io {
+                file: None,
+                msg: e.to_string()
+            })?
         );
     } else {
         println!(
