@@ -184,15 +184,18 @@ mod tests {
     #[test]
     fn messages_are_made_from_the_fields() {
         let e = LabError::at(
-            "run.csv",
+            "fringe.csv",
             4,
             ColumnRef {
                 index: 2,
-                name: Some("rate_dps".into()),
+                name: Some("signal".into()),
             },
             "empty cell",
         );
-        assert_eq!(e.to_string(), "run.csv:4:2 (column `rate_dps`): empty cell");
+        assert_eq!(
+            e.to_string(),
+            "fringe.csv:4:2 (column `signal`): empty cell"
+        );
         assert_eq!(e.exit_code(), 2);
         assert_eq!(
             LabError::at_line("a.csv", 1, "missing column `x`").to_string(),

@@ -3,7 +3,7 @@
 //! degrees of freedom, the dominant noise type and the fitted model.
 
 use crate::error::LabError;
-use crate::report::sig;
+use crate::report::text::sig;
 use std::io::Write;
 use std::path::Path;
 

@@ -203,6 +203,9 @@ pub fn svg(axes: &Axes, series: &[Series]) -> String {
     };
     match result {
         Ok(()) => out,
-        Err(e) => format!("<p>(plot not drawn: {})</p>", super::esc(&e.to_string())),
+        Err(e) => format!(
+            "<p>(plot not drawn: {})</p>",
+            super::text::esc(&e.to_string())
+        ),
     }
 }
