@@ -20,6 +20,8 @@ pub struct Bins {
     pub group: Vec<usize>,
 }
 
+/// The bins of `rows`: runs of consecutive rows at one rate, cut every
+/// [`BIN_S`].
 pub fn bin(inp: &SfInput, rows: &[usize]) -> Bins {
     let mut b = Bins {
         w: vec![],

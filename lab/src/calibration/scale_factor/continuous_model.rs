@@ -22,6 +22,7 @@ pub struct Model {
 }
 
 impl Model {
+    /// The coil temperature of bin `i` at sensor lag `lag`.
     pub fn tc(&self, lag: f64, i: usize) -> f64 {
         self.b.ts[i] + lag * self.b.d[i]
     }

@@ -92,6 +92,7 @@ struct FoundJson {
     explained_share: f64,
 }
 
+/// The JSON of a discovery (docs/interfaces.md keys and more).
 pub fn json(d: &Discovery) -> serde_json::Value {
     let found: Vec<FoundJson> = d
         .found

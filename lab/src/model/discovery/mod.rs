@@ -105,6 +105,8 @@ fn with_found(model: &Model, found: &[Estimate]) -> Model {
     after
 }
 
+/// What `model` misses of `run`: the effects found, the model with them
+/// added, and the residual before and after.
 pub fn discover(model: &Model, run: &Run) -> Discovery {
     let inp = &run.inputs;
     let r = residual(model, run);
