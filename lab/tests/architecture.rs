@@ -12,15 +12,17 @@
 //! - the domain modules (everything but cli/, data/, main.rs and error.rs)
 //!   neither parse arguments (clap), print, nor touch files, paths, the
 //!   environment or the process;
-//! - no `Result<_, String>`.
+//! - no `Result<_, String>`;
+//! - the same cycle and size rules for the dsp crate (dsp/src), whose
+//!   blocks must not import the config that composes them.
 
 // The checks read the source with architecture/scan.rs.
 #[path = "architecture/scan.rs"]
 mod scan;
 
 use scan::{
-    expand_use, find_cycle, graph, has_word, result_args, rust_files, show, sources, strip,
-    top_level, Source,
+    expand_use, find_cycle, graph, has_word, result_args, rust_files, show, sources, sources_in,
+    strip, top_level, Source,
 };
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -37,6 +39,31 @@ fn no_import_cycles() {
     if let Some(c) = find_cycle(&g) {
         let names: Vec<String> = c.iter().map(|m| show(m)).collect();
         panic!("cycle among files: {}", names.join(" -> "));
+    }
+}
+
+/// The dsp crate: no cycle among its modules or files, no file over 800
+/// lines.
+#[test]
+fn dsp_has_no_import_cycles_or_long_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../dsp/src");
+    let files = sources_in(&root);
+    assert!(
+        files.len() > 10,
+        "dsp sources not found at {}",
+        root.display()
+    );
+    let g = graph(&files);
+    if let Some(c) = find_cycle(&top_level(&g)) {
+        panic!("dsp: cycle among top-level modules: {}", c.join(" -> "));
+    }
+    if let Some(c) = find_cycle(&g) {
+        let names: Vec<String> = c.iter().map(|m| show(m)).collect();
+        panic!("dsp: cycle among files: {}", names.join(" -> "));
+    }
+    for f in &files {
+        let n = f.text.lines().count();
+        assert!(n <= MAX_LINES, "dsp/src/{}: {n} lines", f.rel);
     }
 }
 

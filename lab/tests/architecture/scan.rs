@@ -27,7 +27,12 @@ pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 pub fn sources() -> Vec<Source> {
-    let root = src_dir();
+    sources_in(&src_dir())
+}
+
+/// The `.rs` files below `root` (another crate's `src`, e.g. the dsp's).
+pub fn sources_in(root: &Path) -> Vec<Source> {
+    let root = root.to_path_buf();
     let mut files = vec![];
     rust_files(&root, &mut files);
     files.sort();
