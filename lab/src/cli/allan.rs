@@ -8,7 +8,8 @@ use crate::data::allan_file::{self, AllanRow};
 use crate::data::run_file::{Column, Series as RunSeries};
 use crate::error::LabError;
 use crate::noise::analysis::{analyse, sample_period, Allan};
-use crate::noise::terms::{self, COUNT, NAMES, SLOPES, UNITS};
+use crate::noise::model::Interval;
+use crate::noise::terms::{self, shape_name, COUNT, MARKOV_NAME, NAMES, SIN_NAME, SLOPES, UNITS};
 use crate::report::document::Report;
 use crate::report::plot::Axes;
 use crate::report::text::{num, sig};
@@ -39,23 +40,78 @@ struct TermJson {
     hi: f64,
 }
 
-/// The terms as JSON values: {value, lo, hi} or null.
+/// The terms as JSON values: {value, lo, hi, reliable} or null; the
+/// sinusoid and the Markov term with each parameter's interval.
 fn terms_json(a: &Allan) -> serde_json::Map<String, serde_json::Value> {
     let mut m = serde_json::Map::new();
+    let t = &a.terms;
+    let iv = |i: &Interval, k: f64| serde_json::json!({"value": i.value * k, "lo": i.lo * k, "hi": i.hi * k});
     for j in 0..COUNT {
-        let v = if a.terms.present[j] {
-            serde_json::to_value(TermJson {
-                value: terms::to_units(j, a.terms.c[j]),
-                lo: terms::to_units(j, a.terms.lo[j]),
-                hi: terms::to_units(j, a.terms.hi[j]),
+        let v = if t.present[j] {
+            let mut v = serde_json::to_value(TermJson {
+                value: terms::to_units(j, t.c[j]),
+                lo: terms::to_units(j, t.lo[j]),
+                hi: terms::to_units(j, t.hi[j]),
             })
-            .unwrap_or(serde_json::Value::Null)
+            .unwrap_or(serde_json::Value::Null);
+            v["reliable"] = t.reliable[j].into();
+            if let (1, Some(f)) = (j, &t.arw_filter_s) {
+                v["filter_tau_s"] = iv(f, 1.0);
+            }
+            v
         } else {
             serde_json::Value::Null
         };
         m.insert(NAMES[j].into(), v);
     }
+    m.insert(
+        SIN_NAME.into(),
+        t.sinusoid.as_ref().map_or(serde_json::Value::Null, |s| {
+            serde_json::json!({
+                "amplitude_dph": iv(&s.amplitude_dps, DPH),
+                "frequency_hz": iv(&s.frequency_hz, 1.0),
+                "reliable": s.reliable,
+            })
+        }),
+    );
+    m.insert(
+        MARKOV_NAME.into(),
+        t.correlated.as_ref().map_or(serde_json::Value::Null, |c| {
+            serde_json::json!({
+                "sigma_dph": iv(&c.sigma_dph, 1.0),
+                "tau_s": iv(&c.tau_s, 1.0),
+                "white_limit_dpsh": iv(&c.white_limit_dpsh, 1.0),
+                "reliable": c.reliable,
+            })
+        }),
+    );
     m
+}
+
+/// The goodness of fit as JSON.
+fn fit_json(an: &Allan) -> serde_json::Value {
+    let g = &an.terms.goodness;
+    serde_json::json!({
+        "consistent": g.consistent,
+        "chi2_per_dof": g.chi2_per_dof,
+        "chi2_per_dof_limit": g.limit_per_dof,
+        "dof": g.dof,
+        "outside_taus_s": g.outside.iter().map(|&i| an.taus[i]).collect::<Vec<f64>>(),
+        "outside_fraction": g.outside.len() as f64 / an.taus.len().max(1) as f64,
+    })
+}
+
+/// The conventional readings as JSON.
+fn readings_json(an: &Allan) -> serde_json::Value {
+    let r = &an.readings;
+    serde_json::json!({
+        "arw_dpsh": r.arw_dpsh,
+        "arw_region_s": r.arw_region_s.map(|(a, b)| vec![a, b]),
+        "floor_dph": r.floor_dph,
+        "floor_tau_s": r.floor_tau_s,
+        "bias_instability_dph": r.bias_instability_dph,
+        "resolved": r.resolved,
+    })
 }
 
 pub fn run(a: &AllanArgs) -> Result<(), LabError> {
@@ -108,10 +164,13 @@ fn json(an: &Allan, column: &str, (read_s, compute_s): (f64, f64)) -> serde_json
         "adev_lo_dph": lo,
         "adev_hi_dph": hi,
         "terms": terms_json(an),
+        "model_adev_dph": an.terms.model.iter().map(|v| v.sqrt() * DPH).collect::<Vec<f64>>(),
+        "fit": fit_json(an),
+        "readings": readings_json(an),
         "units": units,
         "confidence": terms::CONF,
         "edf": an.terms.edf,
-        "noise_type": an.terms.dominant.iter().map(|&d| NAMES[d]).collect::<Vec<_>>(),
+        "noise_type": an.terms.dominant.iter().map(|&d| shape_name(d)).collect::<Vec<_>>(),
         "samples": an.n,
         "tau0_s": an.tau0,
         "mean_dps": an.mean_dps,
@@ -175,7 +234,7 @@ fn write_csv(an: &Allan, path: &std::path::Path) -> Result<(), LabError> {
             adev_lo_dph: an.avar_lo[i].sqrt() * DPH,
             adev_hi_dph: an.avar_hi[i].sqrt() * DPH,
             edf: an.terms.edf[i],
-            noise_type: NAMES[an.terms.dominant[i]],
+            noise_type: shape_name(an.terms.dominant[i]),
             model_adev_dph: an.terms.model[i].sqrt() * DPH,
         })
         .collect();
