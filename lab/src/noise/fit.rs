@@ -35,6 +35,7 @@ use crate::numerics::stats::chi2_quantile;
 /// must buy to enter the model (two parameters each, the frequency or
 /// correlation time searched over the whole curve).
 pub const PENALTY: f64 = 25.0;
+const LIKELIHOOD_KEEP: bool = true;
 
 fn columns(c: &Curve, active: &[bool; ALL], sh: &Shapes) -> (Vec<usize>, Vec<Vec<f64>>) {
     let idx: Vec<usize> = (0..ALL).filter(|&j| active[j]).collect();
@@ -108,7 +109,9 @@ fn prune_fit(c: &Curve, mut active: [bool; ALL], sh: &Shapes, start: &Fitted) ->
     let mut fit = irls(c, active, sh, start);
     for _round in 0..2 * ALL {
         let mut chk = uncertainty::check(c, &fit);
-        keep_by_likelihood(c, &fit, &mut chk);
+        if LIKELIHOOD_KEEP {
+            keep_by_likelihood(c, &fit, &mut chk);
+        }
         // Shapes the fit left at zero go at once; of the others that the
         // curve does not show, the least significant one (two rising
         // terms may be significant together and not alone).
@@ -145,7 +148,7 @@ fn prune_fit(c: &Curve, mut active: [bool; ALL], sh: &Shapes, start: &Fitted) ->
 /// clearly wants it).
 fn keep_by_likelihood(c: &Curve, fit: &Fitted, chk: &mut Checked) {
     let g = uncertainty::satterthwaite(c, fit).0;
-    let limit = g * chi2_quantile(0.999, 1.0);
+    let limit = g * chi2_quantile(1.0 - 1e-5, 1.0);
     let base = uncertainty::chi2(c, fit);
     for j in 0..ALL {
         if chk.present[j] || !fit.has(j) || !chk.shows[j] {

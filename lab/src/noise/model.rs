@@ -151,26 +151,32 @@ fn markov_inv_sqrt_edf(tau: f64, t: f64, m: usize, n_phase: usize) -> f64 {
 /// type's share s_t with its own (Greenhall) degrees of freedom, combined
 /// as if fully correlated, `1/sqrt(edf) = sum s_t / sqrt(edf_t)` (a
 /// mixture's estimate is no steadier than its noisiest part). A sinusoid
-/// is no noise: its part of an estimate from many periods is fixed.
+/// adds no scatter of its own but beats with the noise: with P_s its part
+/// and P_n the noise's, the estimate's variance is 2 (P_n^2 + 2 P_n P_s) /
+/// edf_n (the mean of (s_k + e_k)^2 over the second differences, s the
+/// sinusoid's, e the noise's).
 pub fn mixture_edf(sh: &Shapes, model: f64, tau: f64, m: usize, n_phase: usize) -> f64 {
     let mut s = 0.0;
+    let mut noise = 0.0;
     for t in 0..ALL {
         let p = sh.part(t, tau);
         if p <= 0.0 || t == SIN {
             continue;
         }
+        noise += p;
         let inv = if t == MARKOV {
             markov_inv_sqrt_edf(tau, sh.t, m, n_phase)
         } else {
             1.0 / edf_oavar(ALPHA[t], m, n_phase).sqrt()
         };
-        s += p / model * inv;
+        s += p * inv;
     }
-    if s > 0.0 {
-        (1.0 / (s * s)).max(1.0)
-    } else {
-        edf_oavar(0, m, n_phase)
+    if s <= 0.0 || noise <= 0.0 {
+        return edf_oavar(0, m, n_phase);
     }
+    let edf_n = (noise * noise / (s * s)).max(1.0);
+    let ps = sh.part(SIN, tau).max(0.0);
+    (model * model * edf_n / (noise * noise + 2.0 * noise * ps)).max(1.0)
 }
 
 /// The model against the measured curve.
