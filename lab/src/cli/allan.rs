@@ -1,7 +1,7 @@
 //! `gyro-lab allan`: noise analysis of a rate column of a run file (IEEE
 //! 952 Allan variance, noise/): the JSON, allan.csv and the report.
 
-use crate::cli::adev_plot::adev_series;
+use crate::cli::adev_plot::{adev_series, misfit_series, missed_series, reading_marks};
 use crate::cli::args::{Json, OutOpt};
 use crate::cli::output::write_report;
 use crate::data::allan_file::{self, AllanRow};
@@ -181,6 +181,202 @@ fn json(an: &Allan, column: &str, (read_s, compute_s): (f64, f64)) -> serde_json
     })
 }
 
+/// The verdict on the fit, one sentence.
+fn verdict(an: &Allan) -> String {
+    let g = &an.terms.goodness;
+    let out: Vec<String> = g.outside.iter().map(|&i| sig(an.taus[i])).collect();
+    if g.consistent && out.is_empty() {
+        format!(
+            "The model fits: it passes through every measured 95 % interval (chi-square per degree of freedom {:.2}, \
+             at most {:.2} for a right model).",
+            g.chi2_per_dof, g.limit_per_dof
+        )
+    } else if g.consistent {
+        format!(
+            "The model fits within the scatter the estimates' correlation allows (chi-square per degree of freedom \
+             {:.2}, at most {:.2} for a right model); it leaves the measured 95 % interval at {} of {} averaging \
+             times: {} s.",
+            g.chi2_per_dof,
+            g.limit_per_dof,
+            out.len(),
+            an.taus.len(),
+            out.join(", ")
+        )
+    } else {
+        format!(
+            "THE MODEL DOES NOT FIT this curve: chi-square per degree of freedom {:.2} where a right model stays \
+             below {:.2}; it leaves the measured 95 % interval at {} of {} averaging times: {} s. Something there \
+             is none of the IEEE 952 terms (or not in the form fitted); the intervals below are widened by the \
+             misfit and the terms carrying those averaging times are marked unreliable.",
+            g.chi2_per_dof,
+            g.limit_per_dof,
+            out.len(),
+            an.taus.len(),
+            out.join(", ")
+        )
+    }
+}
+
+/// The readings, one sentence.
+fn readings_text(an: &Allan) -> String {
+    let r = &an.readings;
+    let n = match (r.arw_dpsh, r.arw_region_s) {
+        (Some(n), Some((a, b))) => format!(
+            "N = {} deg/sqrt(h) on the -1/2 line through {} .. {} s read at 1 s",
+            num(n),
+            sig(a),
+            sig(b)
+        ),
+        _ => "no -1/2 region, so no N reading".into(),
+    };
+    let b = if r.resolved {
+        format!(
+            "floor {} deg/h at {} s, B = floor/0.664 = {} deg/h (the curve turns up after it)",
+            num(r.floor_dph),
+            sig(r.floor_tau_s),
+            num(r.bias_instability_dph)
+        )
+    } else {
+        format!(
+            "lowest point {} deg/h at {} s; the curve does not turn up after it, so the floor is not resolved and \
+             B <= {} deg/h is only an upper bound",
+            num(r.floor_dph),
+            sig(r.floor_tau_s),
+            num(r.bias_instability_dph)
+        )
+    };
+    format!("Readings off the curve: {n}; {b}.")
+}
+
+/// The rows of the terms table (and of the terminal's list).
+fn term_rows(an: &Allan) -> Vec<Vec<String>> {
+    let t = &an.terms;
+    let row = |name: &str, slope: &str, v: f64, lo: f64, hi: f64, unit: &str, rel: bool| {
+        vec![
+            name.to_owned(),
+            slope.to_owned(),
+            num(v),
+            num(lo),
+            num(hi),
+            unit.to_owned(),
+            if rel { "yes".into() } else { "no".into() },
+        ]
+    };
+    let mut rows: Vec<Vec<String>> = (0..COUNT)
+        .map(|j| {
+            if t.present[j] {
+                row(
+                    NAMES[j],
+                    SLOPES[j],
+                    terms::to_units(j, t.c[j]),
+                    terms::to_units(j, t.lo[j]),
+                    terms::to_units(j, t.hi[j]),
+                    UNITS[j],
+                    t.reliable[j],
+                )
+            } else {
+                vec![
+                    NAMES[j].into(),
+                    SLOPES[j].into(),
+                    "absent".into(),
+                    "-".into(),
+                    "-".into(),
+                    UNITS[j].into(),
+                    "-".into(),
+                ]
+            }
+        })
+        .collect();
+    if let Some(f) = &t.arw_filter_s {
+        rows.push(row(
+            "  white noise filter time constant",
+            "bends -1/2 at short tau",
+            f.value,
+            f.lo,
+            f.hi,
+            "s",
+            true,
+        ));
+    }
+    match &t.sinusoid {
+        Some(s) => {
+            let a = &s.amplitude_dps;
+            rows.push(row(
+                "sinusoid amplitude",
+                "bump, then -1",
+                a.value * DPH,
+                a.lo * DPH,
+                a.hi * DPH,
+                "deg/h",
+                s.reliable,
+            ));
+            let f = &s.frequency_hz;
+            rows.push(row(
+                "sinusoid frequency",
+                "bump at 0.37/f",
+                f.value,
+                f.lo,
+                f.hi,
+                "Hz",
+                s.reliable,
+            ));
+        }
+        None => rows.push(vec![
+            SIN_NAME.into(),
+            "bump".into(),
+            "absent".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+        ]),
+    }
+    match &t.correlated {
+        Some(c) => {
+            let s = &c.sigma_dph;
+            rows.push(row(
+                "correlated (Markov) sigma",
+                "+1/2 .. -1/2",
+                s.value,
+                s.lo,
+                s.hi,
+                "deg/h",
+                c.reliable,
+            ));
+            let tc = &c.tau_s;
+            rows.push(row(
+                "correlated (Markov) time",
+                "hump at 1.89 T",
+                tc.value,
+                tc.lo,
+                tc.hi,
+                "s",
+                c.reliable,
+            ));
+            let w = &c.white_limit_dpsh;
+            rows.push(row(
+                "  its white limit N = q T",
+                "-1/2 at tau >> T",
+                w.value,
+                w.lo,
+                w.hi,
+                "deg/sqrt(h)",
+                c.reliable,
+            ));
+        }
+        None => rows.push(vec![
+            MARKOV_NAME.into(),
+            "hump".into(),
+            "absent".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+        ]),
+    }
+    rows
+}
+
 fn print_text(an: &Allan, name: &str, a: &AllanArgs, (read_s, compute_s): (f64, f64)) {
     println!(
         "{}: column `{}`, {} samples at {} s ({:.4} h); {} averaging times {} .. {} s",
@@ -197,25 +393,27 @@ fn print_text(an: &Allan, name: &str, a: &AllanArgs, (read_s, compute_s): (f64, 
         "mean rate {:.6e} +- {:.2e} deg/s (standard error from the noise model at the record length)",
         an.mean_dps, an.mean_se_dps
     );
-    println!("IEEE 952 terms (95 % intervals; fitted to the whole curve):");
-    for j in 0..COUNT {
-        if an.terms.present[j] {
+    println!("{}", verdict(an));
+    println!("IEEE 952 terms (95 % intervals; fitted to the whole curve; absent: the curve does not show it):");
+    for r in term_rows(an) {
+        if r[2] == "absent" {
             println!(
-                "  {:<24} {:>12} [{} .. {}] {}   (slope {})",
-                NAMES[j],
-                num(terms::to_units(j, an.terms.c[j])),
-                num(terms::to_units(j, an.terms.lo[j])),
-                num(terms::to_units(j, an.terms.hi[j])),
-                UNITS[j],
-                SLOPES[j]
+                "  {:<34} absent (the curve does not show slope {})",
+                r[0], r[1]
             );
         } else {
             println!(
-                "  {:<24} absent (the curve does not show slope {})",
-                NAMES[j], SLOPES[j]
+                "  {:<34} {:>12} [{} .. {}] {}{}",
+                r[0],
+                r[2],
+                r[3],
+                r[4],
+                r[5],
+                if r[6] == "no" { "  (unreliable)" } else { "" }
             );
         }
     }
+    println!("{}", readings_text(an));
     println!("read {read_s:.2} s, computed {compute_s:.2} s");
     if let Some(dir) = &a.out.out {
         println!(
@@ -254,8 +452,16 @@ fn report(an: &Allan, name: &str, column: &str) -> Report {
         sig(an.taus[0]),
         sig(an.taus[an.taus.len() - 1])
     ));
-    r.heading("Allan deviation and the fitted noise terms");
-    r.plot(
+    r.heading("Does the model fit?");
+    r.paragraph(&verdict(an));
+    r.heading("Allan deviation, the fitted noise terms and the readings");
+    let mut series = adev_series(an, "measured (95 % interval)", 0, true);
+    if let Some(m) = missed_series(an) {
+        series.insert(1, m);
+    }
+    let (lines, marks) = reading_marks(an);
+    series.extend(lines);
+    r.plot_annotated(
         &Axes {
             title: "Allan deviation".into(),
             x_label: "averaging time tau, s".into(),
@@ -263,44 +469,53 @@ fn report(an: &Allan, name: &str, column: &str) -> Report {
             log_x: true,
             log_y: true,
         },
-        &adev_series(an, "measured (95 % interval)", 0, true),
-        "Measured overlapping Allan deviation with its 95 % intervals, the fitted model (solid) and each term \
-         the curve shows (dashed).",
+        &series,
+        &marks,
+        "Measured overlapping Allan deviation with its 95 % intervals (points the model misses in orange), the \
+         fitted model (solid) and each term it holds (dashed); the conventional readings: the -1/2 line read at \
+         tau = 1 s and the floor.",
+    );
+    r.paragraph(&readings_text(an));
+    r.heading("Where the model misses");
+    r.plot_annotated(
+        &Axes {
+            title: "Normalised residual of the Allan variance".into(),
+            x_label: "averaging time tau, s".into(),
+            y_label: "(measured - model) / sd".into(),
+            log_x: true,
+            log_y: false,
+        },
+        &misfit_series(an),
+        &[],
+        "The measured Allan variance less the model's, in standard deviations of the estimate (from its \
+         equivalent degrees of freedom): a right model keeps within the dashed band at 95 % of the averaging times \
+         (neighbours correlate, so a run of points on one side is common); where points leave it, the model misses \
+         the curve there.",
     );
     r.heading("IEEE 952 noise terms");
-    let rows: Vec<Vec<String>> = (0..COUNT)
-        .map(|j| {
-            if an.terms.present[j] {
-                vec![
-                    NAMES[j].into(),
-                    SLOPES[j].into(),
-                    num(terms::to_units(j, an.terms.c[j])),
-                    num(terms::to_units(j, an.terms.lo[j])),
-                    num(terms::to_units(j, an.terms.hi[j])),
-                    UNITS[j].into(),
-                ]
-            } else {
-                vec![
-                    NAMES[j].into(),
-                    SLOPES[j].into(),
-                    "absent".into(),
-                    "-".into(),
-                    "-".into(),
-                    UNITS[j].into(),
-                ]
-            }
-        })
-        .collect();
     r.table(
-        &["term", "slope", "value", "95 % low", "95 % high", "unit"],
-        &rows,
+        &[
+            "term",
+            "slope",
+            "value",
+            "95 % low",
+            "95 % high",
+            "unit",
+            "reliable",
+        ],
+        &term_rows(an),
     );
     r.note(
-        "The terms are fitted to the whole curve by weighted least squares with non-negative coefficients. A term \
-         is reported only if it carries at least half of the model at some measured averaging time and its \
-         interval excludes zero; otherwise it is absent, not small. Bias instability includes the 0.664 factor \
-         (B = floor / 0.664). Units: quantization in arcsec of angle; angle random walk in deg/sqrt(h); bias \
-         instability in deg/h; rate random walk in deg/h/sqrt(h); rate ramp in deg/h^2.",
+        "The terms are fitted to the whole curve by weighted least squares with non-negative coefficients; the \
+         sinusoid's frequency, the Markov correlation time and the white noise's filter time constant are searched. \
+         A term is reported only if it carries at least half of the model at some measured averaging time and the \
+         curve needs it (its interval excludes zero, or leaving it out costs the fit far more than chance); \
+         otherwise it is absent, not small. A -1 slope is quantization or white angle noise (one shape). The \
+         intervals are widened by the chi-square in excess of a right model's, where the term carries the model \
+         and overall, and to the values the missed points ask for; a term is unreliable where it carries \
+         averaging times the model misses. Bias instability includes the 0.664 factor (B = floor / 0.664). Units: \
+         quantization in arcsec of angle; angle random walk in deg/sqrt(h); bias instability in deg/h; rate random \
+         walk in deg/h/sqrt(h); rate ramp in deg/h^2.",
     );
     r.paragraph(&format!(
         "Mean rate {:.6e} deg/s, standard error {:.2e} deg/s (the fitted model's Allan deviation at the record's \
