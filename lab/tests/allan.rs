@@ -8,40 +8,39 @@
 mod common;
 use common::lab;
 
-use gyro_lab::bench::allan::{SAMPLES, SCENARIOS, TAU0_S};
-use gyro_lab::noise::analysis::analyse;
+use gyro_lab::bench::allan::{judge, truth_present, SAMPLES, SCENARIOS, SHORT, TAU0_S};
+use gyro_lab::noise::analysis::{analyse, Allan};
 use gyro_lab::noise::terms;
-use gyro_lab::sim::noise_run::record;
+use gyro_lab::sim::independent_noise;
+use gyro_lab::sim::noise_run::{record, record_with, Truth};
 
 #[test]
 fn known_terms_recovered_and_absent_ones_not_reported() {
-    // Every scenario, 6 seeds: each present term's interval holds the truth
-    // in at least 5 (the bench: at least 91 of 100), no absent term
-    // reported more than once (the bench: 2 of 2800).
+    // Every scenario (the power laws, the sinusoid, the Markov term), 6
+    // seeds: each present term's intervals hold the truth in at least 5
+    // (the bench: at least 90 of 100), no absent term reported more than
+    // once (the bench: under 1 %).
     for sc in SCENARIOS {
-        let mut held = [0; terms::COUNT];
+        let present = truth_present(&sc.truth);
+        let mut held = [0; terms::ALL];
         let mut false_reports = 0;
         for seed in 1..=6 {
-            let an = analyse(&record(&sc.truth, SAMPLES, TAU0_S, seed), TAU0_S).unwrap();
-            let t = &an.terms;
-            for j in 0..terms::COUNT {
-                if sc.truth[j] > 0.0 {
-                    let (lo, hi) = (terms::to_units(j, t.lo[j]), terms::to_units(j, t.hi[j]));
-                    if t.present[j] && lo <= sc.truth[j] && sc.truth[j] <= hi {
-                        held[j] += 1;
-                    }
-                } else if t.present[j] {
+            let an = analyse(&record_with(&sc.truth, SAMPLES, TAU0_S, seed), TAU0_S).unwrap();
+            for (j, &(reported, ok, _)) in judge(&an, &sc.truth).iter().enumerate() {
+                if present[j] && reported && ok {
+                    held[j] += 1;
+                } else if !present[j] && reported {
                     false_reports += 1;
                 }
             }
         }
-        for j in 0..terms::COUNT {
-            if sc.truth[j] > 0.0 {
+        for j in 0..terms::ALL {
+            if present[j] {
                 assert!(
                     held[j] >= 5,
                     "{}: {} held in {}/6",
                     sc.name,
-                    terms::NAMES[j],
+                    SHORT[j],
                     held[j]
                 );
             }
@@ -51,6 +50,205 @@ fn known_terms_recovered_and_absent_ones_not_reported() {
             "{}: {false_reports} false reports",
             sc.name
         );
+    }
+}
+
+/// The fit's N: the angle random walk term (deg/sqrt(h)).
+fn fitted_n(an: &Allan) -> Option<f64> {
+    an.terms.present[1].then(|| terms::to_units(1, an.terms.c[1]))
+}
+
+/// The fraction of measured intervals the model passes through.
+fn inside_fraction(an: &Allan) -> f64 {
+    1.0 - an.terms.goodness.outside.len() as f64 / an.taus.len() as f64
+}
+
+#[test]
+#[ignore = "issue 21 in progress: the fit does not yet meet this on the independent generator"]
+fn textbook_curve_from_the_independent_generator() {
+    // White noise, flicker and a rate random walk by other algorithms
+    // (FFT flicker, sub-sampled walk, splitmix64 normals): the model
+    // passes through at least 90 % of the intervals, N within 10 % of the
+    // -1/2 line's reading and within its interval of the truth, B no higher
+    // than the floor's reading and within 35 % of it, and the truth.
+    let truth = Truth::laws([0.0, 0.05, 0.2, 0.05, 0.0]);
+    let mut covered = [0; 3];
+    for seed in 1..=4 {
+        let y = independent_noise::record(&truth, SAMPLES, TAU0_S, seed);
+        let an = analyse(&y, TAU0_S).unwrap();
+        let r = &an.readings;
+        assert!(an.terms.goodness.consistent, "seed {seed}");
+        assert!(
+            inside_fraction(&an) >= 0.9,
+            "seed {seed}: {}",
+            inside_fraction(&an)
+        );
+        let n = fitted_n(&an).unwrap();
+        let n_read = r.arw_dpsh.unwrap();
+        assert!(
+            (n / n_read - 1.0).abs() < 0.1,
+            "seed {seed}: N {n} vs {n_read}"
+        );
+        assert!(r.resolved, "seed {seed}");
+        let b = terms::to_units(2, an.terms.c[2]);
+        assert!(
+            b <= r.bias_instability_dph && b >= 0.65 * r.bias_instability_dph,
+            "seed {seed}: B {b} vs {}",
+            r.bias_instability_dph
+        );
+        for (k, j) in [1usize, 2, 3].into_iter().enumerate() {
+            let (lo, hi) = (
+                terms::to_units(j, an.terms.lo[j]),
+                terms::to_units(j, an.terms.hi[j]),
+            );
+            if an.terms.present[j] && lo <= truth.laws[j] && truth.laws[j] <= hi {
+                covered[k] += 1;
+            }
+        }
+        for j in [0, 4] {
+            assert!(
+                !an.terms.present[j],
+                "seed {seed}: {} reported",
+                terms::NAMES[j]
+            );
+        }
+        assert!(
+            an.terms.sinusoid.is_none() && an.terms.correlated.is_none(),
+            "seed {seed}"
+        );
+    }
+    assert!(covered.iter().all(|&c| c >= 3), "{covered:?}");
+}
+
+#[test]
+#[ignore = "issue 21 in progress: the fit does not yet meet this on the independent generator"]
+fn rlg_like_curve_is_quantization_and_a_sinusoid_not_white_noise() {
+    // A true angle quantizer (20 arcsec: quanta of 69 arcsec) on little
+    // white noise, with a sinusoid whose bump sits at 0.37/f = 3.7 s, from
+    // the independent generator: the -1 slope is named quantization, the
+    // bump a sinusoid of the right frequency and amplitude, and any angle
+    // random walk reported stays below the bound the long-tau points give.
+    let truth = Truth {
+        laws: [20.0, 0.002, 0.0, 0.0, 0.0],
+        sinusoid: Some((20.0, 0.1)),
+        markov: None,
+    };
+    for seed in 1..=3 {
+        let y = independent_noise::record(&truth, SAMPLES, TAU0_S, seed);
+        let an = analyse(&y, TAU0_S).unwrap();
+        let t = &an.terms;
+        assert!(t.present[0], "seed {seed}: quantization absent");
+        let q = terms::to_units(0, t.c[0]);
+        assert!((q / 20.0 - 1.0).abs() < 0.05, "seed {seed}: Q {q}");
+        let s = t.sinusoid.as_ref().expect("sinusoid");
+        assert!(
+            (s.frequency_hz.value / 0.1 - 1.0).abs() < 0.02,
+            "seed {seed}: f {:?}",
+            s.frequency_hz
+        );
+        let a = s.amplitude_dps.value * 3600.0;
+        assert!((a / 20.0 - 1.0).abs() < 0.1, "seed {seed}: amplitude {a}");
+        // N^2/tau <= AVAR at every tau: N below min over tau of ADEV sqrt(tau).
+        let bound = (0..an.taus.len())
+            .map(|i| an.avar_hi[i].sqrt() * an.taus[i].sqrt() * 60.0)
+            .fold(f64::INFINITY, f64::min);
+        if let Some(n) = fitted_n(&an) {
+            assert!(
+                n <= bound,
+                "seed {seed}: N {n} above the long-tau bound {bound}"
+            );
+        }
+    }
+}
+
+#[test]
+fn markov_hump_from_the_independent_generator() {
+    // White noise, an AR(1) Markov term (sigma 0.5 deg/h, T 300 s) and no
+    // other term: the Markov term is found, its sigma and time within
+    // their intervals in most seeds, and no flicker or random walk is
+    // invented for its hump.
+    let truth = Truth {
+        laws: [0.0, 0.02, 0.0, 0.0, 0.0],
+        sinusoid: None,
+        markov: Some((0.5, 300.0)),
+    };
+    let mut held = 0;
+    for seed in 1..=4 {
+        let an = analyse(
+            &independent_noise::record(&truth, SAMPLES, TAU0_S, seed),
+            TAU0_S,
+        )
+        .unwrap();
+        let (reported, ok, _) = judge(&an, &truth)[terms::MARKOV];
+        assert!(reported, "seed {seed}");
+        held += usize::from(ok);
+        for j in [0, 2, 3, 4] {
+            assert!(
+                !an.terms.present[j],
+                "seed {seed}: {} reported",
+                terms::NAMES[j]
+            );
+        }
+    }
+    assert!(held >= 3, "{held}/4");
+}
+
+#[test]
+fn a_curve_the_model_cannot_hold_is_said_so_and_where() {
+    // Two sinusoids a decade and a half apart (the model holds one) on
+    // white noise: the fit is inconsistent, the averaging times it misses
+    // include the bump it could not take, and no reported term has an
+    // interval under 1 % wide.
+    let tau0 = 1.0;
+    let mut y = record_with(
+        &Truth {
+            laws: [0.0, 0.05, 0.0, 0.0, 0.0],
+            sinusoid: Some((3.0, 0.1)),
+            markov: None,
+        },
+        SAMPLES,
+        tau0,
+        5,
+    );
+    let extra = record_with(
+        &Truth {
+            laws: [0.0; 5],
+            sinusoid: Some((3.0, 0.003)),
+            markov: None,
+        },
+        SAMPLES,
+        tau0,
+        6,
+    );
+    y.iter_mut().zip(&extra).for_each(|(a, b)| *a += b);
+    let an = analyse(&y, tau0).unwrap();
+    let g = &an.terms.goodness;
+    assert!(!g.consistent, "chi2/dof {}", g.chi2_per_dof);
+    // The bumps: 3.7 s and 123 s; one of them is missed.
+    let missed: Vec<f64> = g.outside.iter().map(|&i| an.taus[i]).collect();
+    assert!(
+        missed.iter().any(|&t| (2.0..6.0).contains(&t))
+            || missed.iter().any(|&t| (60.0..250.0).contains(&t)),
+        "{missed:?}"
+    );
+    let t = &an.terms;
+    for j in 0..terms::COUNT {
+        if t.present[j] {
+            let (v, lo, hi) = (
+                terms::to_units(j, t.c[j]),
+                terms::to_units(j, t.lo[j]),
+                terms::to_units(j, t.hi[j]),
+            );
+            assert!(
+                (hi - lo) / v >= 0.01,
+                "{}: {v} [{lo}, {hi}]",
+                terms::NAMES[j]
+            );
+        }
+    }
+    if let Some(s) = &t.sinusoid {
+        let a = &s.amplitude_dps;
+        assert!((a.hi - a.lo) / a.value >= 0.01, "{a:?}");
     }
 }
 
@@ -133,8 +331,9 @@ fn json_files_and_a_self_contained_report() {
     ] {
         assert!(!stripped.contains(bad), "report holds `{bad}`");
     }
-    // One plot, with both axes' labels, its data points and the fitted line.
-    assert_eq!(html.matches("<svg").count(), 1);
+    // The curve and the panel of normalised residuals, with both axes'
+    // labels, the data points and the fitted line.
+    assert_eq!(html.matches("<svg").count(), 2);
     assert!(html.contains("averaging time tau, s") && html.contains("Allan deviation, deg/h"));
     assert!(html.matches("<circle").count() >= n, "data points");
     assert!(html.contains("<polyline"), "fitted model");

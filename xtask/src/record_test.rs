@@ -417,11 +417,15 @@ pub fn run(
     .unwrap_or_default();
     checks.push((
         "allan_on_the_recorded_file",
-        allan.status.success() && a["taus_s"].as_array().is_some_and(|t| !t.is_empty()),
+        // One frame per row: every lost frame is one filled sample.
+        allan.status.success()
+            && a["taus_s"].as_array().is_some_and(|t| !t.is_empty())
+            && a["gaps"]["filled_samples"].as_u64() == Some(lost),
         format!(
-            "exit {}, {} averaging times",
+            "exit {}, {} averaging times, {} samples filled where {lost} frames were lost",
             allan.status,
-            a["taus_s"].as_array().map_or(0, |t| t.len())
+            a["taus_s"].as_array().map_or(0, |t| t.len()),
+            a["gaps"]["filled_samples"]
         ),
     ));
     let disc = Command::new(&lab)

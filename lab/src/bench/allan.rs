@@ -1,20 +1,23 @@
 //! `gyro-lab bench allan`: recovery of known noise terms from the project's
-//! own generators (`gyro_sim::noise`) over seeds, each term alone and
-//! in combinations; `gyro-lab bench allan-speed`: the time for 10^7
+//! own generators (`gyro_sim::noise`, with the sinusoid and the Markov term
+//! of sim/noise_run.rs) over seeds, each term alone and in combinations; `gyro-lab bench allan-speed`: the time for 10^7
 //! samples against the O(N m) definition on 10^5 (the CSV read of the
 //! record is the command's).
 
 use crate::noise::adev;
-use crate::noise::analysis::{analyse, AllanError, PER_DECADE};
-use crate::noise::terms::{self, COUNT};
-use crate::sim::noise_run::record;
+use crate::noise::analysis::{analyse, Allan, AllanError, PER_DECADE};
+use crate::noise::model::Interval;
+use crate::noise::terms::{self, ALL, COUNT, MARKOV, SIN};
+use crate::sim::noise_run::{record, record_with, Truth};
 
-/// A record of known terms: (Q arcsec, N deg/sqrt(h), B deg/h, K
-/// deg/h/sqrt(h), R deg/h^2), zero where absent.
+/// A record of known terms: the power laws (Q arcsec, N deg/sqrt(h), B
+/// deg/h, K deg/h/sqrt(h), R deg/h^2; zero where absent), a sinusoid
+/// (amplitude deg/h, Hz) and a Markov term (sigma deg/h, correlation time
+/// s).
 #[derive(Clone, Copy, Debug)]
 pub struct Scenario {
     pub name: &'static str,
-    pub truth: [f64; COUNT],
+    pub truth: Truth,
 }
 
 /// 1 s samples, 2e5 of them (55 h): each term of a scenario dominates the
@@ -23,54 +26,126 @@ pub struct Scenario {
 pub const TAU0_S: f64 = 1.0;
 pub const SAMPLES: usize = 200_000;
 
-pub const SCENARIOS: [Scenario; 9] = [
+const fn laws(name: &'static str, laws: [f64; COUNT]) -> Scenario {
     Scenario {
-        name: "white",
-        truth: [0.0, 0.05, 0.0, 0.0, 0.0],
+        name,
+        truth: Truth::laws(laws),
+    }
+}
+
+pub const SCENARIOS: [Scenario; 13] = [
+    laws("white", [0.0, 0.05, 0.0, 0.0, 0.0]),
+    laws("flicker", [0.0, 0.0, 0.1, 0.0, 0.0]),
+    laws("random walk", [0.0, 0.0, 0.0, 0.5, 0.0]),
+    laws("quantization + white", [20.0, 0.1, 0.0, 0.0, 0.0]),
+    laws("white + ramp", [0.0, 0.05, 0.0, 0.0, 0.5]),
+    laws("white + flicker", [0.0, 0.02, 0.1, 0.0, 0.0]),
+    laws("white + random walk", [0.0, 0.05, 0.0, 0.5, 0.0]),
+    laws("white + flicker + random walk", [0.0, 0.006, 0.1, 0.2, 0.0]),
+    laws("quantization + white + flicker", [20.0, 0.1, 0.5, 0.0, 0.0]),
+    // A bump at 0.37/f = 37 s, 4.5 times the white noise there.
+    Scenario {
+        name: "white + sinusoid",
+        truth: Truth {
+            laws: [0.0, 0.05, 0.0, 0.0, 0.0],
+            sinusoid: Some((3.0, 0.01)),
+            markov: None,
+        },
     },
+    // The Markov term's hump near 1.9 T = 570 s, 6 times the white noise.
     Scenario {
-        name: "flicker",
-        truth: [0.0, 0.0, 0.1, 0.0, 0.0],
+        name: "white + Markov",
+        truth: Truth {
+            laws: [0.0, 0.02, 0.0, 0.0, 0.0],
+            sinusoid: None,
+            markov: Some((0.5, 300.0)),
+        },
     },
+    // An RLG's curve: a dither bump on quantization, then white noise.
     Scenario {
-        name: "random walk",
-        truth: [0.0, 0.0, 0.0, 0.5, 0.0],
+        name: "quantization + white + sinusoid",
+        truth: Truth {
+            laws: [20.0, 0.02, 0.0, 0.0, 0.0],
+            sinusoid: Some((20.0, 0.1)),
+            markov: None,
+        },
     },
+    // The hump near 38 s, its white tail to 2000 s, then the floor.
     Scenario {
-        name: "quantization + white",
-        truth: [20.0, 0.1, 0.0, 0.0, 0.0],
-    },
-    Scenario {
-        name: "white + ramp",
-        truth: [0.0, 0.05, 0.0, 0.0, 0.5],
-    },
-    Scenario {
-        name: "white + flicker",
-        truth: [0.0, 0.02, 0.1, 0.0, 0.0],
-    },
-    Scenario {
-        name: "white + random walk",
-        truth: [0.0, 0.05, 0.0, 0.5, 0.0],
-    },
-    Scenario {
-        name: "white + flicker + random walk",
-        truth: [0.0, 0.006, 0.1, 0.2, 0.0],
-    },
-    Scenario {
-        name: "quantization + white + flicker",
-        truth: [20.0, 0.1, 0.5, 0.0, 0.0],
+        name: "white + Markov + flicker",
+        truth: Truth {
+            laws: [0.0, 0.01, 0.1, 0.0, 0.0],
+            sinusoid: None,
+            markov: Some((0.5, 20.0)),
+        },
     },
 ];
+
+/// Short names of the terms for the table's columns: the power laws, the
+/// sinusoid, the Markov term.
+pub const SHORT: [&str; ALL] = ["Q", "N", "B", "K", "R", "S", "M"];
+
+/// Whether each term of `truth` is present (index as the shapes).
+pub fn truth_present(t: &Truth) -> [bool; ALL] {
+    let mut p = [false; ALL];
+    for j in 0..COUNT {
+        p[j] = t.laws[j] > 0.0;
+    }
+    p[SIN] = t.sinusoid.is_some();
+    p[MARKOV] = t.markov.is_some();
+    p
+}
+
+fn holds(i: &Interval, v: f64) -> bool {
+    i.lo <= v && v <= i.hi
+}
+
+/// Per term of an analysis: reported, and (where the truth has it) every
+/// interval of it holding the truth; the value compared (the power law,
+/// the sinusoid's amplitude deg/h, the Markov sigma deg/h).
+pub fn judge(an: &Allan, t: &Truth) -> [(bool, bool, f64); ALL] {
+    let mut out = [(false, false, 0.0); ALL];
+    let tf = &an.terms;
+    for j in 0..COUNT {
+        if tf.present[j] {
+            let (v, lo, hi) = (
+                terms::to_units(j, tf.c[j]),
+                terms::to_units(j, tf.lo[j]),
+                terms::to_units(j, tf.hi[j]),
+            );
+            out[j] = (true, lo <= t.laws[j] && t.laws[j] <= hi, v);
+        }
+    }
+    if let Some(s) = &tf.sinusoid {
+        let held = t
+            .sinusoid
+            .is_some_and(|(a, f)| holds(&s.amplitude_dps, a / 3600.0) && holds(&s.frequency_hz, f));
+        out[SIN] = (true, held, s.amplitude_dps.value * 3600.0);
+    }
+    if let Some(m) = &tf.correlated {
+        let held = t
+            .markov
+            .is_some_and(|(sg, tc)| holds(&m.sigma_dph, sg) && holds(&m.tau_s, tc));
+        out[MARKOV] = (true, held, m.sigma_dph.value);
+    }
+    out
+}
 
 #[derive(serde::Serialize, Default, Clone)]
 pub struct Row {
     pub scenario: &'static str,
-    /// Per term: seeds where it was reported and its interval held the
-    /// truth (present terms), or where it was reported (absent terms).
-    pub recovered: [Option<u64>; COUNT],
-    pub false_reports: [Option<u64>; COUNT],
+    /// Per term (Q, N, B, K, R, sinusoid, Markov): seeds where it was
+    /// reported and every interval of it held the truth (present terms),
+    /// or where it was reported (absent terms).
+    pub recovered: [Option<u64>; ALL],
+    pub false_reports: [Option<u64>; ALL],
     /// Mean of the reported value over the seeds that reported it.
-    pub mean_value: [Option<f64>; COUNT],
+    pub mean_value: [Option<f64>; ALL],
+    /// Seeds whose fit was consistent with the curve.
+    pub consistent: u64,
+    /// Seeds where the white noise was reported filtered (the generators'
+    /// is not).
+    pub filter_reports: u64,
 }
 
 /// The recovery table and its totals: present terms held by their
@@ -91,30 +166,33 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
             scenario: sc.name,
             ..Row::default()
         };
-        let mut sums = [0.0; COUNT];
-        for j in 0..COUNT {
-            if sc.truth[j] > 0.0 {
+        let present = truth_present(&sc.truth);
+        let mut sums = [0.0; ALL];
+        let mut counts = [0u64; ALL];
+        for j in 0..ALL {
+            if present[j] {
                 row.recovered[j] = Some(0);
             } else {
                 row.false_reports[j] = Some(0);
             }
         }
         for seed in 1..=seeds {
-            let y = record(&sc.truth, SAMPLES, TAU0_S, seed);
+            let y = if sc.truth.sinusoid.is_none() && sc.truth.markov.is_none() {
+                record(&sc.truth.laws, SAMPLES, TAU0_S, seed)
+            } else {
+                record_with(&sc.truth, SAMPLES, TAU0_S, seed)
+            };
             let an = analyse(&y, TAU0_S)?;
-            for j in 0..COUNT {
-                let t = &an.terms;
-                if !t.present[j] {
+            row.consistent += u64::from(an.terms.goodness.consistent);
+            row.filter_reports += u64::from(an.terms.arw_filter_s.is_some());
+            for (j, &(reported, held, v)) in judge(&an, &sc.truth).iter().enumerate() {
+                if !reported {
                     continue;
                 }
-                let (v, lo, hi) = (
-                    terms::to_units(j, t.c[j]),
-                    terms::to_units(j, t.lo[j]),
-                    terms::to_units(j, t.hi[j]),
-                );
-                if sc.truth[j] > 0.0 {
+                if present[j] {
                     sums[j] += v;
-                    if lo <= sc.truth[j] && sc.truth[j] <= hi {
+                    counts[j] += 1;
+                    if held {
                         row.recovered[j] = row.recovered[j].map(|c| c + 1);
                     }
                 } else {
@@ -123,9 +201,9 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
             }
             progress();
         }
-        for j in 0..COUNT {
-            if sc.truth[j] > 0.0 {
-                row.mean_value[j] = Some(sums[j] / seeds as f64);
+        for j in 0..ALL {
+            if present[j] && counts[j] > 0 {
+                row.mean_value[j] = Some(sums[j] / counts[j] as f64);
             }
         }
         rows.push(row);
@@ -133,7 +211,7 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
     let n = seeds;
     let (mut rec, mut rec_n, mut fp, mut fp_n) = (0, 0, 0, 0);
     for r in &rows {
-        for j in 0..COUNT {
+        for j in 0..ALL {
             if let Some(c) = r.recovered[j] {
                 rec += c;
                 rec_n += n;
@@ -153,13 +231,17 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
     })
 }
 
-/// The long record of the speed bench: white, flicker and random walk at
-/// 100 Hz.
+/// The long record of the speed bench: white, flicker, random walk, a
+/// sinusoid and a Markov term at 100 Hz.
 pub const SPEED_TAU0_S: f64 = 0.01;
 
 pub fn speed_record(n: usize) -> Vec<f64> {
-    let truth = [0.0, 0.1, 0.05, 0.02, 0.0];
-    record(&truth, n, SPEED_TAU0_S, 1)
+    let truth = Truth {
+        laws: [0.0, 0.1, 0.05, 0.02, 0.0],
+        sinusoid: Some((2.0, 0.5)),
+        markov: Some((0.3, 20.0)),
+    };
+    record_with(&truth, n, SPEED_TAU0_S, 1)
 }
 
 /// The O(N m) definition against the fast estimator on the first 10^5

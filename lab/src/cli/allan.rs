@@ -1,14 +1,16 @@
 //! `gyro-lab allan`: noise analysis of a rate column of a run file (IEEE
 //! 952 Allan variance, noise/): the JSON, allan.csv and the report.
 
-use crate::cli::adev_plot::adev_series;
+use crate::cli::adev_plot::{adev_series, misfit_series, missed_series, reading_marks};
 use crate::cli::args::{Json, OutOpt};
 use crate::cli::output::write_report;
 use crate::data::allan_file::{self, AllanRow};
 use crate::data::run_file::{Column, Series as RunSeries};
 use crate::error::LabError;
-use crate::noise::analysis::{analyse, sample_period, Allan};
-use crate::noise::terms::{self, COUNT, NAMES, SLOPES, UNITS};
+use crate::noise::analysis::{analyse, Allan};
+use crate::noise::gaps::{fill_gaps, Filled};
+use crate::noise::model::Interval;
+use crate::noise::terms::{self, shape_name, COUNT, MARKOV_NAME, NAMES, SIN_NAME, SLOPES, UNITS};
 use crate::report::document::Report;
 use crate::report::plot::Axes;
 use crate::report::text::{num, sig};
@@ -39,23 +41,78 @@ struct TermJson {
     hi: f64,
 }
 
-/// The terms as JSON values: {value, lo, hi} or null.
+/// The terms as JSON values: {value, lo, hi, reliable} or null; the
+/// sinusoid and the Markov term with each parameter's interval.
 fn terms_json(a: &Allan) -> serde_json::Map<String, serde_json::Value> {
     let mut m = serde_json::Map::new();
+    let t = &a.terms;
+    let iv = |i: &Interval, k: f64| serde_json::json!({"value": i.value * k, "lo": i.lo * k, "hi": i.hi * k});
     for j in 0..COUNT {
-        let v = if a.terms.present[j] {
-            serde_json::to_value(TermJson {
-                value: terms::to_units(j, a.terms.c[j]),
-                lo: terms::to_units(j, a.terms.lo[j]),
-                hi: terms::to_units(j, a.terms.hi[j]),
+        let v = if t.present[j] {
+            let mut v = serde_json::to_value(TermJson {
+                value: terms::to_units(j, t.c[j]),
+                lo: terms::to_units(j, t.lo[j]),
+                hi: terms::to_units(j, t.hi[j]),
             })
-            .unwrap_or(serde_json::Value::Null)
+            .unwrap_or(serde_json::Value::Null);
+            v["reliable"] = t.reliable[j].into();
+            if let (1, Some(f)) = (j, &t.arw_filter_s) {
+                v["filter_tau_s"] = iv(f, 1.0);
+            }
+            v
         } else {
             serde_json::Value::Null
         };
         m.insert(NAMES[j].into(), v);
     }
+    m.insert(
+        SIN_NAME.into(),
+        t.sinusoid.as_ref().map_or(serde_json::Value::Null, |s| {
+            serde_json::json!({
+                "amplitude_dph": iv(&s.amplitude_dps, DPH),
+                "frequency_hz": iv(&s.frequency_hz, 1.0),
+                "reliable": s.reliable,
+            })
+        }),
+    );
+    m.insert(
+        MARKOV_NAME.into(),
+        t.correlated.as_ref().map_or(serde_json::Value::Null, |c| {
+            serde_json::json!({
+                "sigma_dph": iv(&c.sigma_dph, 1.0),
+                "tau_s": iv(&c.tau_s, 1.0),
+                "white_limit_dpsh": iv(&c.white_limit_dpsh, 1.0),
+                "reliable": c.reliable,
+            })
+        }),
+    );
     m
+}
+
+/// The goodness of fit as JSON.
+fn fit_json(an: &Allan) -> serde_json::Value {
+    let g = &an.terms.goodness;
+    serde_json::json!({
+        "consistent": g.consistent,
+        "chi2_per_dof": g.chi2_per_dof,
+        "chi2_per_dof_limit": g.limit_per_dof,
+        "dof": g.dof,
+        "outside_taus_s": g.outside.iter().map(|&i| an.taus[i]).collect::<Vec<f64>>(),
+        "outside_fraction": g.outside.len() as f64 / an.taus.len().max(1) as f64,
+    })
+}
+
+/// The conventional readings as JSON.
+fn readings_json(an: &Allan) -> serde_json::Value {
+    let r = &an.readings;
+    serde_json::json!({
+        "arw_dpsh": r.arw_dpsh,
+        "arw_region_s": r.arw_region_s.map(|(a, b)| vec![a, b]),
+        "floor_dph": r.floor_dph,
+        "floor_tau_s": r.floor_tau_s,
+        "bias_instability_dph": r.bias_instability_dph,
+        "resolved": r.resolved,
+    })
 }
 
 pub fn run(a: &AllanArgs) -> Result<(), LabError> {
@@ -72,10 +129,10 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     let series = RunSeries::read(&a.data, &a.column)?;
     let read_s = t_start.elapsed().as_secs_f64();
     spinner.set_message("Allan variance");
-    let y = &series.values;
-    let tau0 = sample_period(&series.t_s).map_err(|e| series.time_error(e.row(), e.to_string()))?;
+    let filled = fill_gaps(&series.t_s, &series.values)
+        .map_err(|e| series.time_error(e.row(), e.to_string()))?;
     let name = a.data.display().to_string();
-    let an = analyse(y, tau0)
+    let an = analyse(&filled.values, filled.tau0)
         .map_err(|e| LabError::input(&a.data, format!("column `{}`: {e}", a.column)))?;
     let compute_s = t_start.elapsed().as_secs_f64() - read_s;
     spinner.finish_and_clear();
@@ -86,16 +143,24 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     }
     let timing = (read_s, compute_s);
     if a.json.json {
-        println!("{}", json(&an, &a.column, timing));
+        println!("{}", json(&an, &a.column, &filled, timing));
         return Ok(());
     }
     print_text(&an, &name, a, timing);
+    if filled.gaps > 0 {
+        println!("{}", gaps_text(&filled));
+    }
     Ok(())
 }
 
 /// The JSON of the analysis (deviations in deg/h), with the read and
 /// compute times.
-fn json(an: &Allan, column: &str, (read_s, compute_s): (f64, f64)) -> serde_json::Value {
+fn json(
+    an: &Allan,
+    column: &str,
+    filled: &Filled,
+    (read_s, compute_s): (f64, f64),
+) -> serde_json::Value {
     let dph = |v: &[f64]| -> Vec<f64> { v.iter().map(|v| v.sqrt() * DPH).collect() };
     let (adev, lo, hi) = (dph(&an.avar), dph(&an.avar_lo), dph(&an.avar_hi));
     let mut units = serde_json::Map::new();
@@ -108,18 +173,234 @@ fn json(an: &Allan, column: &str, (read_s, compute_s): (f64, f64)) -> serde_json
         "adev_lo_dph": lo,
         "adev_hi_dph": hi,
         "terms": terms_json(an),
+        "model_adev_dph": an.terms.model.iter().map(|v| v.sqrt() * DPH).collect::<Vec<f64>>(),
+        "fit": fit_json(an),
+        "readings": readings_json(an),
         "units": units,
         "confidence": terms::CONF,
         "edf": an.terms.edf,
-        "noise_type": an.terms.dominant.iter().map(|&d| NAMES[d]).collect::<Vec<_>>(),
+        "noise_type": an.terms.dominant.iter().map(|&d| shape_name(d)).collect::<Vec<_>>(),
         "samples": an.n,
         "tau0_s": an.tau0,
         "mean_dps": an.mean_dps,
         "mean_se_dps": an.mean_se_dps,
         "column": column,
+        "gaps": {
+            "count": filled.gaps,
+            "filled_samples": filled.filled,
+            "filled_fraction": filled.filled_fraction(),
+        },
         "read_s": read_s,
         "compute_s": compute_s,
     })
+}
+
+/// What filling the record's gaps did, and what it costs.
+fn gaps_text(f: &Filled) -> String {
+    format!(
+        "gaps: {} in the record, {} samples ({:.3} % of the series) filled with the rate over each gap; \
+         the angle is kept, so averages spanning a gap are right, but the noise inside the gaps is \
+         missing and deviations at averaging times shorter than a gap read low by up to that share",
+        f.gaps,
+        f.filled,
+        100.0 * f.filled_fraction()
+    )
+}
+
+/// The verdict on the fit, one sentence.
+fn verdict(an: &Allan) -> String {
+    let g = &an.terms.goodness;
+    let out: Vec<String> = g.outside.iter().map(|&i| sig(an.taus[i])).collect();
+    if g.consistent && out.is_empty() {
+        format!(
+            "The model fits: it passes through every measured 95 % interval (chi-square per degree of freedom {:.2}, \
+             at most {:.2} for a right model).",
+            g.chi2_per_dof, g.limit_per_dof
+        )
+    } else if g.consistent {
+        format!(
+            "The model fits within the scatter the estimates' correlation allows (chi-square per degree of freedom \
+             {:.2}, at most {:.2} for a right model); it leaves the measured 95 % interval at {} of {} averaging \
+             times: {} s.",
+            g.chi2_per_dof,
+            g.limit_per_dof,
+            out.len(),
+            an.taus.len(),
+            out.join(", ")
+        )
+    } else {
+        format!(
+            "THE MODEL DOES NOT FIT this curve: chi-square per degree of freedom {:.2} where a right model stays \
+             below {:.2}; it leaves the measured 95 % interval at {} of {} averaging times: {} s. Something there \
+             is none of the IEEE 952 terms (or not in the form fitted); the intervals below are widened by the \
+             misfit and the terms carrying those averaging times are marked unreliable.",
+            g.chi2_per_dof,
+            g.limit_per_dof,
+            out.len(),
+            an.taus.len(),
+            out.join(", ")
+        )
+    }
+}
+
+/// The readings, one sentence.
+fn readings_text(an: &Allan) -> String {
+    let r = &an.readings;
+    let n = match (r.arw_dpsh, r.arw_region_s) {
+        (Some(n), Some((a, b))) => format!(
+            "N = {} deg/sqrt(h) on the -1/2 line through {} .. {} s read at 1 s",
+            num(n),
+            sig(a),
+            sig(b)
+        ),
+        _ => "no -1/2 region, so no N reading".into(),
+    };
+    let b = if r.resolved {
+        format!(
+            "floor {} deg/h at {} s, B = floor/0.664 = {} deg/h (the curve turns up after it)",
+            num(r.floor_dph),
+            sig(r.floor_tau_s),
+            num(r.bias_instability_dph)
+        )
+    } else {
+        format!(
+            "lowest point {} deg/h at {} s; the curve does not turn up after it, so the floor is not resolved and \
+             B <= {} deg/h is only an upper bound",
+            num(r.floor_dph),
+            sig(r.floor_tau_s),
+            num(r.bias_instability_dph)
+        )
+    };
+    format!("Readings off the curve: {n}; {b}.")
+}
+
+/// The rows of the terms table (and of the terminal's list).
+fn term_rows(an: &Allan) -> Vec<Vec<String>> {
+    let t = &an.terms;
+    let row = |name: &str, slope: &str, v: f64, lo: f64, hi: f64, unit: &str, rel: bool| {
+        vec![
+            name.to_owned(),
+            slope.to_owned(),
+            num(v),
+            num(lo),
+            num(hi),
+            unit.to_owned(),
+            if rel { "yes".into() } else { "no".into() },
+        ]
+    };
+    let mut rows: Vec<Vec<String>> = (0..COUNT)
+        .map(|j| {
+            if t.present[j] {
+                row(
+                    NAMES[j],
+                    SLOPES[j],
+                    terms::to_units(j, t.c[j]),
+                    terms::to_units(j, t.lo[j]),
+                    terms::to_units(j, t.hi[j]),
+                    UNITS[j],
+                    t.reliable[j],
+                )
+            } else {
+                vec![
+                    NAMES[j].into(),
+                    SLOPES[j].into(),
+                    "absent".into(),
+                    "-".into(),
+                    "-".into(),
+                    UNITS[j].into(),
+                    "-".into(),
+                ]
+            }
+        })
+        .collect();
+    if let Some(f) = &t.arw_filter_s {
+        rows.push(row(
+            "  white noise filter time constant",
+            "bends -1/2 at short tau",
+            f.value,
+            f.lo,
+            f.hi,
+            "s",
+            true,
+        ));
+    }
+    match &t.sinusoid {
+        Some(s) => {
+            let a = &s.amplitude_dps;
+            rows.push(row(
+                "sinusoid amplitude",
+                "bump, then -1",
+                a.value * DPH,
+                a.lo * DPH,
+                a.hi * DPH,
+                "deg/h",
+                s.reliable,
+            ));
+            let f = &s.frequency_hz;
+            rows.push(row(
+                "sinusoid frequency",
+                "bump at 0.37/f",
+                f.value,
+                f.lo,
+                f.hi,
+                "Hz",
+                s.reliable,
+            ));
+        }
+        None => rows.push(vec![
+            SIN_NAME.into(),
+            "bump".into(),
+            "absent".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+        ]),
+    }
+    match &t.correlated {
+        Some(c) => {
+            let s = &c.sigma_dph;
+            rows.push(row(
+                "correlated (Markov) sigma",
+                "+1/2 .. -1/2",
+                s.value,
+                s.lo,
+                s.hi,
+                "deg/h",
+                c.reliable,
+            ));
+            let tc = &c.tau_s;
+            rows.push(row(
+                "correlated (Markov) time",
+                "hump at 1.89 T",
+                tc.value,
+                tc.lo,
+                tc.hi,
+                "s",
+                c.reliable,
+            ));
+            let w = &c.white_limit_dpsh;
+            rows.push(row(
+                "  its white limit N = q T",
+                "-1/2 at tau >> T",
+                w.value,
+                w.lo,
+                w.hi,
+                "deg/sqrt(h)",
+                c.reliable,
+            ));
+        }
+        None => rows.push(vec![
+            MARKOV_NAME.into(),
+            "hump".into(),
+            "absent".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+            "-".into(),
+        ]),
+    }
+    rows
 }
 
 fn print_text(an: &Allan, name: &str, a: &AllanArgs, (read_s, compute_s): (f64, f64)) {
@@ -138,25 +419,27 @@ fn print_text(an: &Allan, name: &str, a: &AllanArgs, (read_s, compute_s): (f64, 
         "mean rate {:.6e} +- {:.2e} deg/s (standard error from the noise model at the record length)",
         an.mean_dps, an.mean_se_dps
     );
-    println!("IEEE 952 terms (95 % intervals; fitted to the whole curve):");
-    for j in 0..COUNT {
-        if an.terms.present[j] {
+    println!("{}", verdict(an));
+    println!("IEEE 952 terms (95 % intervals; fitted to the whole curve; absent: the curve does not show it):");
+    for r in term_rows(an) {
+        if r[2] == "absent" {
             println!(
-                "  {:<24} {:>12} [{} .. {}] {}   (slope {})",
-                NAMES[j],
-                num(terms::to_units(j, an.terms.c[j])),
-                num(terms::to_units(j, an.terms.lo[j])),
-                num(terms::to_units(j, an.terms.hi[j])),
-                UNITS[j],
-                SLOPES[j]
+                "  {:<34} absent (the curve does not show slope {})",
+                r[0], r[1]
             );
         } else {
             println!(
-                "  {:<24} absent (the curve does not show slope {})",
-                NAMES[j], SLOPES[j]
+                "  {:<34} {:>12} [{} .. {}] {}{}",
+                r[0],
+                r[2],
+                r[3],
+                r[4],
+                r[5],
+                if r[6] == "no" { "  (unreliable)" } else { "" }
             );
         }
     }
+    println!("{}", readings_text(an));
     println!("read {read_s:.2} s, computed {compute_s:.2} s");
     if let Some(dir) = &a.out.out {
         println!(
@@ -175,7 +458,7 @@ fn write_csv(an: &Allan, path: &std::path::Path) -> Result<(), LabError> {
             adev_lo_dph: an.avar_lo[i].sqrt() * DPH,
             adev_hi_dph: an.avar_hi[i].sqrt() * DPH,
             edf: an.terms.edf[i],
-            noise_type: NAMES[an.terms.dominant[i]],
+            noise_type: shape_name(an.terms.dominant[i]),
             model_adev_dph: an.terms.model[i].sqrt() * DPH,
         })
         .collect();
@@ -195,8 +478,16 @@ fn report(an: &Allan, name: &str, column: &str) -> Report {
         sig(an.taus[0]),
         sig(an.taus[an.taus.len() - 1])
     ));
-    r.heading("Allan deviation and the fitted noise terms");
-    r.plot(
+    r.heading("Does the model fit?");
+    r.paragraph(&verdict(an));
+    r.heading("Allan deviation, the fitted noise terms and the readings");
+    let mut series = adev_series(an, "measured (95 % interval)", 0, true);
+    if let Some(m) = missed_series(an) {
+        series.insert(1, m);
+    }
+    let (lines, marks) = reading_marks(an);
+    series.extend(lines);
+    r.plot_annotated(
         &Axes {
             title: "Allan deviation".into(),
             x_label: "averaging time tau, s".into(),
@@ -204,44 +495,53 @@ fn report(an: &Allan, name: &str, column: &str) -> Report {
             log_x: true,
             log_y: true,
         },
-        &adev_series(an, "measured (95 % interval)", 0, true),
-        "Measured overlapping Allan deviation with its 95 % intervals, the fitted model (solid) and each term \
-         the curve shows (dashed).",
+        &series,
+        &marks,
+        "Measured overlapping Allan deviation with its 95 % intervals (points the model misses in orange), the \
+         fitted model (solid) and each term it holds (dashed); the conventional readings: the -1/2 line read at \
+         tau = 1 s and the floor.",
+    );
+    r.paragraph(&readings_text(an));
+    r.heading("Where the model misses");
+    r.plot_annotated(
+        &Axes {
+            title: "Normalised residual of the Allan variance".into(),
+            x_label: "averaging time tau, s".into(),
+            y_label: "(measured - model) / sd".into(),
+            log_x: true,
+            log_y: false,
+        },
+        &misfit_series(an),
+        &[],
+        "The measured Allan variance less the model's, in standard deviations of the estimate (from its \
+         equivalent degrees of freedom): a right model keeps within the dashed band at 95 % of the averaging times \
+         (neighbours correlate, so a run of points on one side is common); where points leave it, the model misses \
+         the curve there.",
     );
     r.heading("IEEE 952 noise terms");
-    let rows: Vec<Vec<String>> = (0..COUNT)
-        .map(|j| {
-            if an.terms.present[j] {
-                vec![
-                    NAMES[j].into(),
-                    SLOPES[j].into(),
-                    num(terms::to_units(j, an.terms.c[j])),
-                    num(terms::to_units(j, an.terms.lo[j])),
-                    num(terms::to_units(j, an.terms.hi[j])),
-                    UNITS[j].into(),
-                ]
-            } else {
-                vec![
-                    NAMES[j].into(),
-                    SLOPES[j].into(),
-                    "absent".into(),
-                    "-".into(),
-                    "-".into(),
-                    UNITS[j].into(),
-                ]
-            }
-        })
-        .collect();
     r.table(
-        &["term", "slope", "value", "95 % low", "95 % high", "unit"],
-        &rows,
+        &[
+            "term",
+            "slope",
+            "value",
+            "95 % low",
+            "95 % high",
+            "unit",
+            "reliable",
+        ],
+        &term_rows(an),
     );
     r.note(
-        "The terms are fitted to the whole curve by weighted least squares with non-negative coefficients. A term \
-         is reported only if it carries at least half of the model at some measured averaging time and its \
-         interval excludes zero; otherwise it is absent, not small. Bias instability includes the 0.664 factor \
-         (B = floor / 0.664). Units: quantization in arcsec of angle; angle random walk in deg/sqrt(h); bias \
-         instability in deg/h; rate random walk in deg/h/sqrt(h); rate ramp in deg/h^2.",
+        "The terms are fitted to the whole curve by weighted least squares with non-negative coefficients; the \
+         sinusoid's frequency, the Markov correlation time and the white noise's filter time constant are searched. \
+         A term is reported only if it carries at least half of the model at some measured averaging time and the \
+         curve needs it (its interval excludes zero, or leaving it out costs the fit far more than chance); \
+         otherwise it is absent, not small. A -1 slope is quantization or white angle noise (one shape). The \
+         intervals are widened by the chi-square in excess of a right model's, where the term carries the model \
+         and overall, and to the values the missed points ask for; a term is unreliable where it carries \
+         averaging times the model misses. Bias instability includes the 0.664 factor (B = floor / 0.664). Units: \
+         quantization in arcsec of angle; angle random walk in deg/sqrt(h); bias instability in deg/h; rate random \
+         walk in deg/h/sqrt(h); rate ramp in deg/h^2.",
     );
     r.paragraph(&format!(
         "Mean rate {:.6e} deg/s, standard error {:.2e} deg/s (the fitted model's Allan deviation at the record's \

@@ -3,7 +3,8 @@
 //! JSON line.
 
 use crate::bench::allan::{
-    against_definition, recovery, speed_record, Recovery, SAMPLES, SCENARIOS, SPEED_TAU0_S, TAU0_S,
+    against_definition, recovery, speed_record, Recovery, SAMPLES, SCENARIOS, SHORT, SPEED_TAU0_S,
+    TAU0_S,
 };
 use crate::bench::discover_summary::summarize;
 use crate::bench::discover_trials::{run_all, trials, TrialCounts};
@@ -15,7 +16,7 @@ use crate::data::csv_writer::CellFormat::{Exp, Fixed};
 use crate::data::run_file::{Column, RunWriter, Series};
 use crate::error::LabError;
 use crate::noise::analysis::analyse;
-use crate::noise::terms::{COUNT, NAMES, UNITS};
+use crate::noise::terms::{ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS};
 use crate::sim::scale_factor_rig::RigParams;
 use clap::{Args, Subcommand};
 
@@ -180,9 +181,6 @@ pub struct AllanBenchArgs {
     pub json: Json,
 }
 
-/// Short names of the noise terms for the table's columns.
-const SHORT: [&str; COUNT] = ["Q", "N", "B", "K", "R"];
-
 fn allan(a: &AllanBenchArgs) -> Result<(), LabError> {
     if a.seeds == 0 || a.seeds > 10_000 {
         return Err(LabError::Usage(format!("--seeds {}: 1..=10000", a.seeds)));
@@ -201,7 +199,8 @@ fn allan(a: &AllanBenchArgs) -> Result<(), LabError> {
     println!(
         "{}",
         serde_json::json!({
-            "seeds": n, "samples": SAMPLES, "tau0_s": TAU0_S, "terms": NAMES,
+            "seeds": n, "samples": SAMPLES, "tau0_s": TAU0_S,
+            "terms": NAMES.iter().chain(&[SIN_NAME, MARKOV_NAME]).collect::<Vec<_>>(),
             "rows": r.rows, "recovered": r.recovered, "recovered_of": r.recovered_of,
             "false_reports": r.false_reports, "false_reports_of": r.false_reports_of
         })
@@ -214,27 +213,40 @@ fn print_allan(r: &Recovery, n: u64) {
         "Allan terms from the project's generators: {} samples at {} s, {n} seeds per scenario; 95 % intervals",
         SAMPLES, TAU0_S
     );
-    println!("cells: truth -> seeds whose interval holds it / mean value; absent terms: seeds that reported them");
-    print!("{:<32}", "scenario");
-    for j in 0..COUNT {
-        print!(" {:>24}", format!("{} ({})", SHORT[j], UNITS[j]));
+    println!(
+        "cells: truth -> seeds whose intervals hold it / mean value (S: sinusoid amplitude deg/h and frequency; \
+         M: Markov sigma deg/h and correlation time); absent terms: seeds that reported them"
+    );
+    let unit = |j: usize| if j < COUNT { UNITS[j] } else { "deg/h" };
+    print!("{:<34}", "scenario");
+    for j in 0..ALL {
+        print!(" {:>22}", format!("{} ({})", SHORT[j], unit(j)));
     }
-    println!();
+    println!(" {:>10} {:>8}", "consistent", "filter");
     for (row, sc) in r.rows.iter().zip(SCENARIOS) {
-        print!("{:<32}", row.scenario);
-        for j in 0..COUNT {
+        print!("{:<34}", row.scenario);
+        let truth = |j: usize| match j {
+            SIN => sc.truth.sinusoid.map_or(0.0, |s| s.0),
+            MARKOV => sc.truth.markov.map_or(0.0, |m| m.0),
+            j => sc.truth.laws[j],
+        };
+        for j in 0..ALL {
             let cell = match (row.recovered[j], row.false_reports[j]) {
                 (Some(c), _) => format!(
                     "{} -> {c}/{n} {:.3}",
-                    sc.truth[j],
+                    truth(j),
                     row.mean_value[j].unwrap_or(f64::NAN)
                 ),
                 (_, Some(c)) => format!("absent: {c}/{n}"),
                 _ => "-".into(),
             };
-            print!(" {cell:>24}");
+            print!(" {cell:>22}");
         }
-        println!();
+        println!(
+            " {:>10} {:>8}",
+            format!("{}/{n}", row.consistent),
+            format!("{}/{n}", row.filter_reports)
+        );
     }
     let (rec, rec_n, fp, fp_n) = (
         r.recovered,

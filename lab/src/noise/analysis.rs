@@ -1,10 +1,12 @@
 //! The Allan analysis of one rate record (IEEE 952, docs/noise.md):
 //! overlapping Allan deviation at log-spaced averaging times (adev.rs) with
-//! chi-square intervals from Greenhall's degrees of freedom (edf.rs), and
-//! the noise terms fitted to the whole curve (terms.rs).
+//! chi-square intervals from Greenhall's degrees of freedom (edf.rs), the
+//! noise terms fitted to the whole curve and checked against it (fit.rs,
+//! uncertainty.rs), and the conventional readings (readings.rs).
 
-use super::terms::{self, TermFit};
-use super::{adev, edf};
+use super::model::TermFit;
+use super::readings::{self, Readings};
+use super::{adev, edf, fit, terms};
 
 /// Averaging times per decade.
 pub const PER_DECADE: usize = 10;
@@ -22,6 +24,8 @@ pub struct Allan {
     pub avar_lo: Vec<f64>,
     pub avar_hi: Vec<f64>,
     pub terms: TermFit,
+    /// The conventional readings off the measured curve.
+    pub readings: Readings,
     /// Mean rate, deg/s, and its standard error: the fitted model's Allan
     /// deviation at the record's length (for white noise exactly the
     /// standard error of the mean; it holds for correlated noise too).
@@ -66,13 +70,15 @@ pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
     let ms = adev::averaging_factors(n, PER_DECADE);
     let taus: Vec<f64> = ms.iter().map(|&m| m as f64 * tau0).collect();
     let avar = adev::oavar(y, &ms);
-    let terms = terms::fit(&taus, &avar, &ms, n + 1);
+    let terms = fit::fit(&taus, &avar, &ms, n + 1);
     let (mut lo, mut hi) = (vec![], vec![]);
     for (i, &a) in avar.iter().enumerate() {
         let (l, h) = edf::interval(a.sqrt(), terms.edf[i], terms::CONF);
         lo.push(l * l);
         hi.push(h * h);
     }
+    let dph = |v: &[f64]| -> Vec<f64> { v.iter().map(|v| v.sqrt() * 3600.0).collect() };
+    let readings = readings::read(&taus, &dph(&avar), &dph(&lo), &dph(&hi));
     let mean = y.iter().sum::<f64>() / n as f64;
     let mean_se = terms.model_at(n as f64 * tau0).sqrt();
     Ok(Allan {
@@ -84,6 +90,7 @@ pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
         avar_lo: lo,
         avar_hi: hi,
         terms,
+        readings,
         mean_dps: mean,
         mean_se_dps: mean_se,
     })

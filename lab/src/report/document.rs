@@ -68,6 +68,26 @@ impl Report {
         );
     }
 
+    /// A plot whose legend stands beside the data, never on it, with
+    /// labelled marks on the curve.
+    pub fn plot_annotated(
+        &mut self,
+        axes: &Axes,
+        series: &[Series],
+        marks: &[super::annotated::Mark],
+        caption: &str,
+    ) {
+        self.figures += 1;
+        let svg = super::annotated::svg(axes, series, marks, 500);
+        let _ = write!(
+            self.body,
+            "<figure id=\"fig{}\">\n{svg}\n<figcaption>Figure {}. {}</figcaption>\n</figure>\n",
+            self.figures,
+            self.figures,
+            esc(caption)
+        );
+    }
+
     pub fn html(&self) -> String {
         format!(
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{t}</title>\n\

@@ -60,7 +60,7 @@ pub struct Axes {
     pub log_y: bool,
 }
 
-const PALETTE: [RGBColor; 8] = [
+pub(crate) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -73,7 +73,7 @@ const PALETTE: [RGBColor; 8] = [
 
 /// Data range of all series (error bars included), padded; positive only
 /// on log axes.
-fn range(series: &[Series], y: bool, log: bool) -> (f64, f64) {
+pub(crate) fn range(series: &[Series], y: bool, log: bool) -> (f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     let mut take = |v: f64| {

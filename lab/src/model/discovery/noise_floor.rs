@@ -3,7 +3,8 @@
 //! out.
 
 use super::windows::Windows;
-use crate::noise::analysis::{analyse, sample_period, Allan};
+use crate::noise::analysis::{analyse, Allan};
+use crate::noise::gaps::fill_gaps;
 use crate::noise::terms;
 
 /// A stretch where the model and the data disagree.
@@ -26,8 +27,10 @@ pub fn allan_of(t: &[f64], r: &[f64]) -> Option<Allan> {
     if t.len() < 10 {
         return None;
     }
-    let tau0 = sample_period(t).ok()?;
-    analyse(r, tau0).ok()
+    // Lost frames leave whole-sample gaps; the residual's noise model is
+    // read from the series made uniform (noise/gaps.rs).
+    let f = fill_gaps(t, r).ok()?;
+    analyse(&f.values, f.tau0).ok()
 }
 
 /// The noise of a mean over `tau` from a residual's Allan model

@@ -1,0 +1,199 @@
+//! The noise model's types (docs/noise.md): the shapes' coefficients, the
+//! measured curve, a model fitted to it, the reported terms with their
+//! intervals and the goodness of fit; and the degrees of freedom of a
+//! mixture of noise types.
+
+use super::edf::edf_oavar;
+use super::terms::{shape, ALL, ALPHA, COUNT, MARKOV, SIN};
+
+/// The coefficients of the seven shapes (terms.rs: c_j >= 0, zero where
+/// absent), the sinusoid's frequency (Hz), the Markov correlation time (s)
+/// and the white noise's filter time constant (s, 0 where unfiltered).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Shapes {
+    pub c: [f64; ALL],
+    pub f: f64,
+    pub t: f64,
+    pub tf: f64,
+}
+
+impl Shapes {
+    /// Shape j's part of the AVAR at tau.
+    pub fn part(&self, j: usize, tau: f64) -> f64 {
+        if self.c[j] > 0.0 {
+            self.c[j] * self.unit(j, tau)
+        } else {
+            0.0
+        }
+    }
+    pub fn at(&self, tau: f64) -> f64 {
+        (0..ALL).map(|j| self.part(j, tau)).sum()
+    }
+    /// Shape j at tau for a unit coefficient.
+    pub fn unit(&self, j: usize, tau: f64) -> f64 {
+        shape(j, tau, self.f, self.t, self.tf)
+    }
+}
+
+/// A value with its 95 % interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    pub value: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// The sinusoid: amplitude deg/s, frequency Hz.
+#[derive(Clone, Copy, Debug)]
+pub struct Sinusoid {
+    pub amplitude_dps: Interval,
+    pub frequency_hz: Interval,
+    pub reliable: bool,
+}
+
+/// The first-order Markov term: stationary sigma deg/h, correlation time
+/// s; its white-noise limit N = q_c T_c (deg/sqrt(h)) and short-tau limit
+/// K = q_c (deg/h/sqrt(h)).
+#[derive(Clone, Copy, Debug)]
+pub struct Correlated {
+    pub sigma_dph: Interval,
+    pub tau_s: Interval,
+    pub white_limit_dpsh: Interval,
+    pub reliable: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct TermFit {
+    /// The power laws (c units, terms.rs), present or not, with their
+    /// intervals (honest: widened where the model misses, uncertainty.rs).
+    pub c: [f64; COUNT],
+    pub present: [bool; COUNT],
+    pub lo: [f64; COUNT],
+    pub hi: [f64; COUNT],
+    /// False where the term dominates averaging times the model misses.
+    pub reliable: [bool; COUNT],
+    pub sinusoid: Option<Sinusoid>,
+    pub correlated: Option<Correlated>,
+    /// The time constant of the filter the white rate noise passed (its
+    /// curve bends below the -1/2 line at the shortest averaging times), s.
+    pub arw_filter_s: Option<Interval>,
+    /// Every shape's coefficient, the frequency and the correlation time.
+    pub shapes: Shapes,
+    /// Per averaging time: the model's AVAR, the shape dominating it
+    /// (index into the shapes, terms::shape_name) and the degrees of
+    /// freedom used.
+    pub model: Vec<f64>,
+    pub dominant: Vec<usize>,
+    pub edf: Vec<f64>,
+    /// The model against the measured intervals.
+    pub goodness: Goodness,
+}
+
+impl TermFit {
+    pub fn model_at(&self, tau: f64) -> f64 {
+        self.shapes.at(tau)
+    }
+}
+
+/// The measured curve: AVAR at taus (averaging factors ms) of a record of
+/// n_phase angle points.
+pub struct Curve<'a> {
+    pub taus: &'a [f64],
+    pub avar: &'a [f64],
+    pub ms: &'a [usize],
+    pub n_phase: usize,
+}
+
+impl Curve<'_> {
+    pub fn n(&self) -> usize {
+        self.taus.len()
+    }
+    pub fn tau0(&self) -> f64 {
+        self.taus[0] / self.ms[0] as f64
+    }
+}
+
+/// A model fitted at one frequency and correlation time: its shapes, the
+/// shapes it may use, its AVAR and degrees of freedom per averaging time.
+#[derive(Clone, Debug)]
+pub struct Fitted {
+    pub shapes: Shapes,
+    pub active: [bool; ALL],
+    pub model: Vec<f64>,
+    pub edf: Vec<f64>,
+}
+
+impl Fitted {
+    /// Whether shape j is in the model.
+    pub fn has(&self, j: usize) -> bool {
+        self.active[j] && self.shapes.c[j] > 0.0
+    }
+    /// Whether the white noise is filtered.
+    pub fn filtered(&self) -> bool {
+        self.has(1) && self.shapes.tf > 0.0
+    }
+    /// How many searched parameters the model has (frequency, correlation
+    /// time, filter time constant).
+    pub fn nonlinear(&self) -> usize {
+        usize::from(self.has(SIN)) + usize::from(self.has(MARKOV)) + usize::from(self.filtered())
+    }
+}
+
+/// Degrees of freedom of the Markov term's estimates at tau: a rate random
+/// walk well below its correlation time, white noise well above, combined
+/// as a mixture is.
+fn markov_inv_sqrt_edf(tau: f64, t: f64, m: usize, n_phase: usize) -> f64 {
+    let s = 1.0 / (1.0 + tau / t);
+    s / edf_oavar(-2, m, n_phase).sqrt() + (1.0 - s) / edf_oavar(0, m, n_phase).sqrt()
+}
+
+/// Degrees of freedom of an estimate whose model is a mixture: each noise
+/// type's share s_t with its own (Greenhall) degrees of freedom, combined
+/// as if fully correlated, `1/sqrt(edf) = sum s_t / sqrt(edf_t)` (a
+/// mixture's estimate is no steadier than its noisiest part). A sinusoid
+/// adds no scatter of its own but beats with the noise: with P_s its part
+/// and P_n the noise's, the estimate's variance is 2 (P_n^2 + 2 P_n P_s) /
+/// edf_n (the mean of (s_k + e_k)^2 over the second differences, s the
+/// sinusoid's, e the noise's).
+pub fn mixture_edf(sh: &Shapes, model: f64, tau: f64, m: usize, n_phase: usize) -> f64 {
+    let mut s = 0.0;
+    let mut noise = 0.0;
+    for t in 0..ALL {
+        let p = sh.part(t, tau);
+        if p <= 0.0 || t == SIN {
+            continue;
+        }
+        noise += p;
+        let inv = if t == MARKOV {
+            markov_inv_sqrt_edf(tau, sh.t, m, n_phase)
+        } else {
+            1.0 / edf_oavar(ALPHA[t], m, n_phase).sqrt()
+        };
+        s += p * inv;
+    }
+    if s <= 0.0 || noise <= 0.0 {
+        return edf_oavar(0, m, n_phase);
+    }
+    let edf_n = (noise * noise / (s * s)).max(1.0);
+    let ps = sh.part(SIN, tau).max(0.0);
+    (model * model * edf_n / (noise * noise + 2.0 * noise * ps)).max(1.0)
+}
+
+/// The model against the measured curve.
+#[derive(Clone, Debug, Default)]
+pub struct Goodness {
+    pub chi2: f64,
+    /// Averaging times less fitted parameters.
+    pub dof: f64,
+    pub chi2_per_dof: f64,
+    /// The largest chi-square per degree of freedom a right model gives in
+    /// 99 % of records (correlated estimates: above 1 by more than the
+    /// independent case).
+    pub limit_per_dof: f64,
+    pub consistent: bool,
+    /// Indices of the averaging times where the model leaves the measured
+    /// 95 % interval.
+    pub outside: Vec<usize>,
+    /// Normalised residuals (AVAR - model)/sd.
+    pub z: Vec<f64>,
+}

@@ -1,0 +1,452 @@
+//! How far a fitted noise model can be trusted (docs/noise.md):
+//!
+//! - The estimates' covariance: variance 2 AVAR^2/edf each, correlated
+//!   between averaging times (overlapping estimates share samples). Per
+//!   noise type the correlation of the estimates at tau1 < tau2 (Monte
+//!   Carlo on the project's generators) falls as (tau1/tau2)^beta, beta 1.1
+//!   for white rate noise, 0.7 for flicker (and a Markov term), 0.35 for
+//!   random walk, and is about 0.3 at any ratio for white angle noise; a
+//!   mixture's estimates correlate as the share-weighted sum of these. A
+//!   sinusoid adds no scatter.
+//! - The parameters' covariance: the sandwich `(J'WJ)^-1 J'W S W J
+//!   (J'WJ)^-1`, J the model's derivatives (the coefficients, and the log
+//!   of the sinusoid's frequency and of the Markov correlation time), S the
+//!   estimates' covariance. Conditional on the model.
+//! - Goodness of fit: z_i = (AVAR_i - model_i) / sd_i, chi-square = sum
+//!   z_i^2. Correlated estimates make it a scaled chi-square (Satterthwaite:
+//!   g chi2_h with g = tr(R^2)/n, h = n/g, R the estimates' correlation);
+//!   the model is consistent when the chi-square is below the 99 % point of
+//!   that distribution (residual degrees of freedom h (n - p)/n).
+//! - Honest intervals: each parameter's variance is multiplied by the
+//!   larger of 1, the chi-square per degree of freedom and the mean z^2
+//!   where its term carries the model (weighted by its share). Where the
+//!   model leaves the measured intervals at averaging times a term
+//!   dominates, the term's interval is widened to the values those points
+//!   ask for and the term is marked unreliable; so is a term whose own
+//!   curve stands above a measured interval (it contradicts the curve).
+
+use super::edf::interval;
+use super::model::{Correlated, Curve, Fitted, Goodness, Interval, Sinusoid, TermFit};
+use super::terms::{ALL, CONF, COUNT, MARKOV, SIN};
+use crate::numerics::stats::{chi2_quantile, normal_quantile};
+use nalgebra::DMatrix;
+
+/// A fitted parameter: a shape's coefficient, the log frequency, the log
+/// correlation time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Param {
+    Coef(usize),
+    LnF,
+    LnT,
+    LnTf,
+}
+
+impl Param {
+    fn shape(self) -> usize {
+        match self {
+            Param::Coef(j) => j,
+            Param::LnF => SIN,
+            Param::LnT => MARKOV,
+            Param::LnTf => 1,
+        }
+    }
+}
+
+/// Which shapes the curve shows, with the parameters' covariance.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    pub present: [bool; ALL],
+    /// Coefficient over its standard error (0 where not fitted).
+    pub significance: [f64; ALL],
+    /// Whether the shape carries half of the model somewhere.
+    pub shows: [bool; ALL],
+    /// Kept by the likelihood though its interval reaches zero (fit.rs).
+    pub by_likelihood: [bool; ALL],
+    pub params: Vec<Param>,
+    pub cov: Option<DMatrix<f64>>,
+}
+
+fn z95() -> f64 {
+    normal_quantile(0.5 + CONF / 2.0)
+}
+
+/// Correlation of two AVAR estimates of shape t at taus with ratio r >= 1.
+fn kernel(t: usize, r: f64) -> f64 {
+    if r == 1.0 {
+        return 1.0;
+    }
+    match t {
+        0 => 0.3,
+        1 => r.powf(-1.1),
+        2 | MARKOV => r.powf(-0.7),
+        SIN => 0.0,
+        _ => r.powf(-0.35),
+    }
+}
+
+fn sds(f: &Fitted) -> Vec<f64> {
+    f.model
+        .iter()
+        .zip(&f.edf)
+        .map(|(m, e)| m * (2.0 / e).sqrt())
+        .collect()
+}
+
+/// The estimates' correlation matrix under the model.
+pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
+    let n = c.taus.len();
+    let share: Vec<[f64; ALL]> = (0..n)
+        .map(|i| {
+            let mut s = [0.0; ALL];
+            for (t, v) in s.iter_mut().enumerate() {
+                if t != SIN {
+                    *v = f.shapes.part(t, c.taus[i]).max(0.0);
+                }
+            }
+            let tot: f64 = s.iter().sum();
+            if tot > 0.0 {
+                s.iter_mut().for_each(|v| *v /= tot);
+            } else {
+                s[1] = 1.0;
+            }
+            s
+        })
+        .collect();
+    DMatrix::from_fn(n, n, |i, j| {
+        if i == j {
+            return 1.0;
+        }
+        let r = c.taus[i].max(c.taus[j]) / c.taus[i].min(c.taus[j]);
+        (0..ALL)
+            .map(|t| (share[i][t] * share[j][t]).sqrt() * kernel(t, r))
+            .sum()
+    })
+}
+
+/// Satterthwaite's scale g and degrees of freedom h of the chi-square of
+/// correlated estimates.
+pub fn satterthwaite(c: &Curve, f: &Fitted) -> (f64, f64) {
+    let r = correlation(c, f);
+    let n = c.taus.len() as f64;
+    let tr2: f64 = r.iter().map(|v| v * v).sum();
+    let g = (tr2 / n).max(1.0);
+    (g, n / g)
+}
+
+/// Normalised residuals of the model.
+fn residuals(c: &Curve, f: &Fitted) -> Vec<f64> {
+    sds(f)
+        .iter()
+        .enumerate()
+        .map(|(i, sd)| (c.avar[i] - f.model[i]) / sd)
+        .collect()
+}
+
+pub fn chi2(c: &Curve, f: &Fitted) -> f64 {
+    residuals(c, f).iter().map(|z| z * z).sum()
+}
+
+fn params(f: &Fitted) -> Vec<Param> {
+    let mut p: Vec<Param> = (0..ALL).filter(|&j| f.has(j)).map(Param::Coef).collect();
+    if f.has(SIN) {
+        p.push(Param::LnF);
+    }
+    if f.has(MARKOV) {
+        p.push(Param::LnT);
+    }
+    if f.filtered() {
+        p.push(Param::LnTf);
+    }
+    p
+}
+
+/// d model(tau) / d param.
+fn derivative(f: &Fitted, p: Param, tau: f64) -> f64 {
+    let sh = &f.shapes;
+    let h = 1e-5f64;
+    let moved = |p: Param, e: f64| {
+        let mut s = *sh;
+        match p {
+            Param::LnF => s.f *= e.exp(),
+            Param::LnT => s.t *= e.exp(),
+            _ => s.tf *= e.exp(),
+        }
+        s.part(p.shape(), tau)
+    };
+    match p {
+        Param::Coef(j) => sh.unit(j, tau),
+        _ => (moved(p, h) - moved(p, -h)) / (2.0 * h),
+    }
+}
+
+/// The sandwich covariance of the model's parameters.
+fn covariance(c: &Curve, f: &Fitted, ps: &[Param]) -> Option<DMatrix<f64>> {
+    let (n, p) = (c.taus.len(), ps.len());
+    if p == 0 || n < p {
+        return None;
+    }
+    let x = DMatrix::from_fn(n, p, |i, k| derivative(f, ps[k], c.taus[i]));
+    let scale: Vec<f64> = (0..p)
+        .map(|k| x.column(k).norm().max(f64::MIN_POSITIVE))
+        .collect();
+    let xs = DMatrix::from_fn(n, p, |i, k| x[(i, k)] / scale[k]);
+    let sd = sds(f);
+    let wx = DMatrix::from_fn(n, p, |i, k| xs[(i, k)] / (sd[i] * sd[i]));
+    let bread = (xs.transpose() * &wx).try_inverse()?;
+    let rho = correlation(c, f);
+    let sigma = DMatrix::from_fn(n, n, |i, j| rho[(i, j)] * sd[i] * sd[j]);
+    let meat = wx.transpose() * sigma * &wx;
+    let cov = &bread * meat * &bread;
+    let out = DMatrix::from_fn(p, p, |a, b| cov[(a, b)] / (scale[a] * scale[b]));
+    (0..p).all(|k| out[(k, k)].is_finite()).then_some(out)
+}
+
+/// Whether shape j carries at least half of the model somewhere.
+fn shows(c: &Curve, f: &Fitted, j: usize) -> bool {
+    (0..c.taus.len()).any(|i| f.shapes.part(j, c.taus[i]) >= 0.5 * f.model[i])
+}
+
+/// Which shapes of the fit the curve shows: at least half of the model
+/// somewhere, and an interval of the coefficient that excludes zero.
+pub fn check(c: &Curve, f: &Fitted) -> Checked {
+    let ps = params(f);
+    let cov = covariance(c, f, &ps);
+    let mut present = [false; ALL];
+    let mut significance = [0.0; ALL];
+    match &cov {
+        Some(cov) => {
+            for (k, p) in ps.iter().enumerate() {
+                if let Param::Coef(j) = *p {
+                    let se = cov[(k, k)].max(0.0).sqrt();
+                    significance[j] = f.shapes.c[j] / se.max(f64::MIN_POSITIVE);
+                    present[j] = shows(c, f, j) && f.shapes.c[j] - z95() * se > 0.0;
+                }
+            }
+        }
+        None => {
+            // Degenerate: the power laws that show stay, the searched
+            // shapes go.
+            for j in 0..COUNT {
+                present[j] = f.has(j) && shows(c, f, j);
+            }
+        }
+    }
+    let mut sh = [false; ALL];
+    for (j, v) in sh.iter_mut().enumerate() {
+        *v = f.has(j) && shows(c, f, j);
+    }
+    Checked {
+        present,
+        significance,
+        shows: sh,
+        by_likelihood: [false; ALL],
+        params: ps,
+        cov,
+    }
+}
+
+/// The model's goodness of fit.
+fn goodness(c: &Curve, f: &Fitted, n_params: usize) -> Goodness {
+    let n = c.taus.len();
+    let z = residuals(c, f);
+    let chi2: f64 = z.iter().map(|v| v * v).sum();
+    let dof = (n as f64 - n_params as f64).max(1.0);
+    let (g, h) = satterthwaite(c, f);
+    let h_res = (h * dof / n as f64).max(1.0);
+    let limit = g * chi2_quantile(0.99, h_res);
+    let outside: Vec<usize> = (0..n)
+        .filter(|&i| {
+            let (lo, hi) = interval(c.avar[i].sqrt(), f.edf[i], CONF);
+            let m = f.model[i].sqrt();
+            m < lo || m > hi
+        })
+        .collect();
+    Goodness {
+        chi2,
+        dof,
+        chi2_per_dof: chi2 / dof,
+        limit_per_dof: limit / dof,
+        consistent: chi2 <= limit,
+        outside,
+        z,
+    }
+}
+
+/// Shape j's share of the model at averaging time i.
+fn share(c: &Curve, f: &Fitted, j: usize, i: usize) -> f64 {
+    f.shapes.part(j, c.taus[i]) / f.model[i]
+}
+
+/// The fit made into the report: goodness, honest intervals, reliability.
+pub fn finish(c: &Curve, f: Fitted, chk: Checked) -> TermFit {
+    let n = c.taus.len();
+    let ps = chk.params.clone();
+    let good = goodness(c, &f, ps.len());
+    let z = &good.z;
+    let global = good.chi2_per_dof;
+    let expect = good.dof / n as f64;
+    // Variance inflation per parameter.
+    let lambda: Vec<f64> = ps
+        .iter()
+        .map(|p| {
+            let j = p.shape();
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in 0..n {
+                let s = share(c, &f, j, i);
+                num += s * z[i] * z[i];
+                den += s;
+            }
+            let local = if den > 0.0 { num / den / expect } else { 1.0 };
+            local.max(global).max(1.0)
+        })
+        .collect();
+    let se: Vec<f64> = (0..ps.len())
+        .map(|k| {
+            chk.cov
+                .as_ref()
+                .map_or(f64::INFINITY, |cv| (cv[(k, k)].max(0.0) * lambda[k]).sqrt())
+        })
+        .collect();
+    let cov_of = |a: usize, b: usize| -> f64 {
+        chk.cov
+            .as_ref()
+            .map_or(0.0, |cv| cv[(a, b)] * (lambda[a] * lambda[b]).sqrt())
+    };
+    let zq = z95();
+    // Measured intervals (variance).
+    let meas: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            let (lo, hi) = interval(c.avar[i].sqrt(), f.edf[i], CONF);
+            (lo * lo, hi * hi)
+        })
+        .collect();
+    // Coefficient intervals, widened to what the missed points ask for.
+    let mut lo = [0.0; ALL];
+    let mut hi = [0.0; ALL];
+    let mut reliable = [true; ALL];
+    for (k, p) in ps.iter().enumerate() {
+        let Param::Coef(j) = *p else { continue };
+        let cj = f.shapes.c[j];
+        lo[j] = cj - zq * se[k];
+        hi[j] = cj + zq * se[k];
+        for i in 0..n {
+            let b = f.shapes.unit(j, c.taus[i]);
+            let s = share(c, &f, j, i);
+            if good.outside.contains(&i) && s >= 0.5 {
+                let implied = cj + (c.avar[i] - f.model[i]) / b;
+                lo[j] = lo[j].min(implied);
+                hi[j] = hi[j].max(implied);
+                reliable[j] = false;
+            }
+            if f.shapes.part(j, c.taus[i]) > meas[i].1 {
+                reliable[j] = false;
+            }
+        }
+        if lo[j] <= 0.0 && !chk.by_likelihood[j] {
+            reliable[j] = false;
+        }
+        lo[j] = lo[j].max(0.0);
+    }
+    let index = |want: Param| ps.iter().position(|&p| p == want);
+    let sinusoid = (f.has(SIN)).then(|| {
+        let (a2, a2lo, a2hi) = (f.shapes.c[SIN], lo[SIN], hi[SIN]);
+        let k = index(Param::LnF);
+        let sf = k.map_or(f64::INFINITY, |k| se[k]);
+        Sinusoid {
+            amplitude_dps: Interval {
+                value: a2.sqrt(),
+                lo: a2lo.max(0.0).sqrt(),
+                hi: a2hi.max(0.0).sqrt(),
+            },
+            frequency_hz: Interval {
+                value: f.shapes.f,
+                lo: f.shapes.f * (-zq * sf).exp(),
+                hi: f.shapes.f * (zq * sf).exp(),
+            },
+            reliable: reliable[SIN],
+        }
+    });
+    let correlated = (f.has(MARKOV)).then(|| {
+        let (q2, t) = (f.shapes.c[MARKOV], f.shapes.t);
+        let kq = index(Param::Coef(MARKOV));
+        let kt = index(Param::LnT);
+        let (vq, vt, cqt) = match (kq, kt) {
+            (Some(a), Some(b)) => (se[a] * se[a] / (q2 * q2), se[b] * se[b], cov_of(a, b) / q2),
+            _ => (f64::INFINITY, f64::INFINITY, 0.0),
+        };
+        // Widening of q_c^2 carried over (relative).
+        let wq = ((hi[MARKOV] - q2) / (zq * q2)).powi(2).max(vq);
+        let sigma = super::terms::markov_sigma_dph(q2, t);
+        let s_sigma = (0.25 * (wq + vt) + 0.5 * cqt).max(0.0).sqrt();
+        // N = q_c T_c: ln N = ln q_c^2 / 2 + ln T_c.
+        let white = super::terms::markov_white_dpsh(q2, t);
+        let s_white = (0.25 * wq + vt + cqt).max(0.0).sqrt();
+        let ratio = |s: f64| (zq * s).exp();
+        Correlated {
+            sigma_dph: Interval {
+                value: sigma,
+                lo: sigma / ratio(s_sigma),
+                hi: sigma * ratio(s_sigma),
+            },
+            tau_s: Interval {
+                value: t,
+                lo: t / ratio(vt.sqrt()),
+                hi: t * ratio(vt.sqrt()),
+            },
+            white_limit_dpsh: Interval {
+                value: white,
+                lo: white / ratio(s_white),
+                hi: white * ratio(s_white),
+            },
+            reliable: reliable[MARKOV],
+        }
+    });
+    let arw_filter_s = f.filtered().then(|| {
+        let k = index(Param::LnTf);
+        let sv = k.map_or(f64::INFINITY, |k| se[k]);
+        let tf = f.shapes.tf;
+        Interval {
+            value: tf,
+            lo: tf * (-zq * sv).exp(),
+            hi: tf * (zq * sv).exp(),
+        }
+    });
+    let dominant: Vec<usize> = (0..n)
+        .map(|i| {
+            (0..ALL)
+                .max_by(|&a, &b| {
+                    f.shapes
+                        .part(a, c.taus[i])
+                        .total_cmp(&f.shapes.part(b, c.taus[i]))
+                })
+                .unwrap_or(1)
+        })
+        .collect();
+    let mut present = [false; COUNT];
+    let (mut plo, mut phi, mut prel) = ([0.0; COUNT], [0.0; COUNT], [true; COUNT]);
+    let mut cc = [0.0; COUNT];
+    for j in 0..COUNT {
+        present[j] = f.has(j) && chk.present[j];
+        cc[j] = f.shapes.c[j];
+        if present[j] {
+            plo[j] = lo[j];
+            phi[j] = hi[j];
+            prel[j] = reliable[j];
+        }
+    }
+    TermFit {
+        c: cc,
+        present,
+        lo: plo,
+        hi: phi,
+        reliable: prel,
+        sinusoid,
+        correlated,
+        arw_filter_s,
+        shapes: f.shapes,
+        model: f.model,
+        dominant,
+        edf: f.edf,
+        goodness: good,
+    }
+}
