@@ -2,11 +2,14 @@
 //! FOG core closed around the simulated optics (fog_run.rs), an RLG in a
 //! thermal chamber (chamber.rs), the FOG scale-factor rig (scale_factor_rig.rs),
 //! RLG fringes near lock-in (fringe.rs), a gyro model with the project's
-//! noise (model_run.rs) and records of known noise terms (noise_run.rs).
+//! noise (model_run.rs), records of known noise terms (noise_run.rs), and a
+//! second generator written apart from the project's for discovery's
+//! held-out set (heldout_run.rs).
 
 pub mod chamber;
 pub mod fog_run;
 pub mod fringe;
+pub mod heldout_run;
 pub mod model_run;
 pub mod noise_run;
 pub mod scale_factor_rig;
