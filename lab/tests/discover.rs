@@ -5,10 +5,8 @@
 mod common;
 use common::{json, lab};
 
-use gyro_lab::bench::discover_trials::{draw, trial, TrialKind};
+use gyro_lab::bench::discover_trials::{draw, trial, Trial, TrialKind};
 use gyro_lab::model::effects::Effect;
-use gyro_lab::model::gyro_kind::GyroKind;
-use gyro_lab::model::gyro_model::Model;
 use gyro_lab::sim::model_run::TestProfile;
 use rand_core::SeedableRng;
 
@@ -135,59 +133,62 @@ fn warm_up_from_the_chamber_simulation() {
 #[test]
 fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(99);
-    let model_of = |g: GyroKind, e| Model {
-        gyro: g,
-        nominal: toml::Table::new(),
-        effects: e,
-    };
     for (i, e) in Effect::ALL.into_iter().enumerate() {
         let (p, h, known) = draw(e, &mut rng);
-        let mut truth = known.clone();
-        truth.push(h.clone());
-        let o = trial(
+        let o = trial(&Trial::hiding(
             TrialKind::Single(e),
             p,
-            &model_of(p.gyro(), truth),
-            &model_of(p.gyro(), known),
-            &[h],
+            known,
+            vec![h],
             500 + i as u64,
-        );
-        assert!(o.named_right && o.params_ok && o.gap_ok, "{o:?}");
+        ));
+        assert!(o.right && o.params_ok && o.gap_ok && !o.gap_grew, "{o:?}");
     }
     // Nothing missing: the model is the truth.
     let (p, h, mut known) = draw(Effect::ThermalDifference, &mut rng);
     known.push(h);
-    let m = model_of(p.gyro(), known);
-    let o = trial(TrialKind::NothingMissing, p, &m, &m, &[], 601);
-    assert!(o.named.is_empty() && o.ambiguous.is_empty(), "{o:?}");
+    let o = trial(&Trial::hiding(
+        TrialKind::NothingMissing,
+        p,
+        known,
+        vec![],
+        601,
+    ));
+    assert!(
+        o.named.is_empty() && o.ambiguous.is_empty() && !o.unexplained,
+        "{o:?}"
+    );
     // Two hidden.
     let hidden = vec![
         draw(Effect::Bias, &mut rng).1,
         draw(Effect::ScaleFactorError, &mut rng).1,
     ];
-    let o = trial(
+    let o = trial(&Trial::hiding(
         TrialKind::TwoHidden,
         TestProfile::Table,
-        &model_of(GyroKind::Fog, hidden.clone()),
-        &model_of(GyroKind::Fog, vec![]),
-        &hidden,
+        vec![],
+        hidden,
         602,
-    );
-    assert!(o.named_right && o.params_ok, "{o:?}");
+    ));
+    assert!(o.right && o.params_ok, "{o:?}");
     // Collinear by construction: a scale-factor error at one rate is a bias.
     let h = draw(Effect::ScaleFactorError, &mut rng).1;
-    let o = trial(
+    let o = trial(&Trial::hiding(
         TrialKind::Collinear,
         TestProfile::ConstantRate,
-        &model_of(GyroKind::Fog, vec![h.clone()]),
-        &model_of(GyroKind::Fog, vec![]),
-        &[h],
+        vec![],
+        vec![h],
         603,
-    );
+    ));
     assert!(o.named.is_empty(), "{o:?}");
     let g = &o.ambiguous[0];
     assert!(
         g.contains(&Effect::Bias) && g.contains(&Effect::ScaleFactorError),
+        "{o:?}"
+    );
+    // ... and the model carries the bias for the group: the gap shrinks.
+    assert!(
+        o.carried.contains(&Effect::Bias) && o.gap_shrink > 0.8,
         "{o:?}"
     );
 }

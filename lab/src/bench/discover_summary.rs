@@ -1,46 +1,87 @@
-//! The figures of `gyro-lab bench discover` from its trials' outcomes:
-//! single hidden effects named right, with their parameters and the gap;
-//! false effects; the nothing-missing, two-hidden and collinear trials; and
-//! the confusion table (what was named against what was hidden).
+//! The figures of `gyro-lab bench discover` from its trials' outcomes: per
+//! category the trials right, the false names, the gap growing and the
+//! interval coverage; and the confusion table (what was named, reported
+//! ambiguous or unexplained, against what was hidden).
 
 use super::discover_trials::{Outcome, TrialKind};
 use crate::model::effects::Effect;
 use std::collections::BTreeMap;
 
-/// Hidden effect (or trial kind) -> named effects and the counts.
+/// Row (what was hidden) -> column (what was said) -> count.
 pub type Confusion = BTreeMap<String, BTreeMap<String, usize>>;
 
+/// A category's or the whole bench's figures.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Tally {
+    pub trials: usize,
+    pub right: usize,
+    pub false_names: usize,
+    pub gap_grew: usize,
+    pub unexplained: usize,
+    pub covered: usize,
+    pub intervals: usize,
+    /// Of the trials with an effect hidden and named right: every
+    /// parameter within 10 %, and the gap to reality shrunk 80 %.
+    pub named_right_with_truth: usize,
+    pub params_ok: usize,
+    pub gap_ok: usize,
+}
+
+impl Tally {
+    fn add(&mut self, o: &Outcome) {
+        self.trials += 1;
+        self.right += usize::from(o.right);
+        self.false_names += o.false_names;
+        self.gap_grew += usize::from(o.gap_grew);
+        self.unexplained += usize::from(o.unexplained);
+        self.covered += o.covered;
+        self.intervals += o.intervals;
+        if o.right && !o.expect.is_empty() && !o.named.is_empty() {
+            self.named_right_with_truth += 1;
+            self.params_ok += usize::from(o.params_ok);
+            self.gap_ok += usize::from(o.gap_ok);
+        }
+    }
+
+    /// Interval coverage, percent.
+    pub fn coverage_pct(&self) -> f64 {
+        100.0 * self.covered as f64 / self.intervals.max(1) as f64
+    }
+}
+
 pub struct Summary {
-    /// Single-effect trials, and of them: named right, with every
-    /// parameter within 10 % too, with the gap shrunk 80 % too.
-    pub single: usize,
-    pub single_named_right: usize,
-    pub single_params_ok: usize,
-    pub single_gap_ok: usize,
-    /// Trials with drawn effects (all but the collinear ones), and those
-    /// naming a false effect.
-    pub randomized: usize,
-    pub false_effect_named: usize,
-    pub nothing_missing_clean: usize,
-    pub two_hidden_both_found: usize,
-    pub collinear_ambiguous: usize,
+    pub total: Tally,
+    /// Per category (the trial kinds, single effects together).
+    pub categories: BTreeMap<String, Tally>,
     pub confusion: Confusion,
+}
+
+/// The category a trial counts in.
+pub fn category(k: TrialKind) -> String {
+    match k {
+        TrialKind::Single(_) => "single effect".into(),
+        TrialKind::BiasThermal(_) => "bias + thermal term (RLG chamber)".into(),
+        TrialKind::Outside(_) => "outside the library".into(),
+        TrialKind::Weak(_) => "weak (1.5 x floor)".into(),
+        k => k.to_string(),
+    }
 }
 
 fn confusion(outcomes: &[Outcome]) -> Confusion {
     let mut conf: Confusion = BTreeMap::new();
     for o in outcomes {
-        let row = if o.hidden.is_empty() {
-            o.kind.to_string()
-        } else if matches!(o.kind, TrialKind::TwoHidden | TrialKind::Collinear) {
-            format!("{} ({})", Effect::names(&o.hidden, " + "), o.kind)
-        } else {
-            Effect::names(&o.hidden, " + ")
+        let row = match o.kind {
+            TrialKind::Single(_) => Effect::names(&o.expect, " + "),
+            TrialKind::TwoHidden | TrialKind::Collinear => {
+                format!("{} ({})", Effect::names(&o.expect, " + "), o.kind)
+            }
+            k => k.to_string(),
         };
         let r = conf.entry(row).or_default();
         *r.entry("trials".into()).or_default() += 1;
+        *r.entry("right".into()).or_default() += usize::from(o.right);
         if o.named.is_empty() && o.ambiguous.is_empty() {
-            *r.entry("nothing".into()).or_default() += 1;
+            *r.entry("nothing named".into()).or_default() += 1;
         }
         for n in &o.named {
             *r.entry(n.name().into()).or_default() += 1;
@@ -49,34 +90,26 @@ fn confusion(outcomes: &[Outcome]) -> Confusion {
             *r.entry(format!("ambiguous {}", Effect::names(g, "/")))
                 .or_default() += 1;
         }
-        if !o.hidden.is_empty() && o.named_right {
-            *r.entry("params within 10 %".into()).or_default() += usize::from(o.params_ok);
-            *r.entry("gap shrinks 80 %".into()).or_default() += usize::from(o.gap_ok);
+        if o.unexplained {
+            *r.entry("unexplained".into()).or_default() += 1;
+        }
+        if o.gap_grew {
+            *r.entry("gap grew".into()).or_default() += 1;
         }
     }
     conf
 }
 
 pub fn summarize(outcomes: &[Outcome]) -> Summary {
-    let count = |kind: &dyn Fn(TrialKind) -> bool, f: &dyn Fn(&Outcome) -> bool| {
-        outcomes.iter().filter(|o| kind(o.kind) && f(o)).count()
-    };
-    let single = |k: TrialKind| matches!(k, TrialKind::Single(_));
-    let randomized = |k: TrialKind| k != TrialKind::Collinear;
+    let mut total = Tally::default();
+    let mut categories: BTreeMap<String, Tally> = BTreeMap::new();
+    for o in outcomes {
+        total.add(o);
+        categories.entry(category(o.kind)).or_default().add(o);
+    }
     Summary {
-        single: count(&single, &|_| true),
-        single_named_right: count(&single, &|o| o.named_right),
-        single_params_ok: count(&single, &|o| o.named_right && o.params_ok),
-        single_gap_ok: count(&single, &|o| o.named_right && o.gap_ok),
-        randomized: count(&randomized, &|_| true),
-        false_effect_named: count(&randomized, &|o| o.false_effect),
-        nothing_missing_clean: count(&|k| k == TrialKind::NothingMissing, &|o| o.named.is_empty()),
-        two_hidden_both_found: count(&|k| k == TrialKind::TwoHidden, &|o| o.named_right),
-        collinear_ambiguous: count(&|k| k == TrialKind::Collinear, &|o| {
-            o.ambiguous
-                .iter()
-                .any(|g| o.hidden.iter().all(|h| g.contains(h)))
-        }),
+        total,
+        categories,
         confusion: confusion(outcomes),
     }
 }

@@ -1,9 +1,12 @@
 //! The estimators against the simulators' truth, over seeds: lock-in
 //! (lockin.rs), scale factor (scale_factor.rs), Allan terms and speed
-//! (allan.rs), discovery (discover_trials.rs, discover_summary.rs). Each
-//! returns its figures; the bench command prints them.
+//! (allan.rs), discovery (discover_trials.rs, discover_categories.rs,
+//! discover_summary.rs; discover_heldout.rs scores the second generator's
+//! held-out set). Each returns its figures; the bench command prints them.
 
 pub mod allan;
+pub mod discover_categories;
+pub mod discover_heldout;
 pub mod discover_summary;
 pub mod discover_trials;
 pub mod lockin;

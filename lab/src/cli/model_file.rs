@@ -2,16 +2,50 @@
 //! `simulate run`): the text is model/file.rs's.
 
 use crate::error::{ColumnRef, LabError};
-use crate::model::file::{parse, to_toml, ModelFileError};
+use crate::model::file::{check_on_run, parse_placed, to_toml, ModelFileError, Places};
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::Model;
-use std::path::Path;
+use crate::model::ranges::Extent;
+use std::path::{Path, PathBuf};
+
+/// A model read from its file, with what the checks on a run need.
+pub struct ModelFile {
+    pub model: Model,
+    path: PathBuf,
+    text: String,
+    places: Vec<Places>,
+}
+
+impl ModelFile {
+    /// The domains that depend on the run (a knee inside the temperatures
+    /// it covers), refused at the parameter's line and column.
+    pub fn check_on_run(&self, extent: &Extent) -> Result<(), LabError> {
+        check_on_run(&self.text, &self.model, &self.places, extent)
+            .map_err(|e| placed(&self.path, e))
+    }
+}
 
 /// Reads and checks a model file for a gyro of kind `gyro` (the one
 /// `--gyro` or the profile asks for).
 pub fn read_model(path: &Path, gyro: GyroKind) -> Result<Model, LabError> {
+    read_model_file(path, gyro).map(|m| m.model)
+}
+
+/// [`read_model`], keeping the text for the checks on a run.
+pub fn read_model_file(path: &Path, gyro: GyroKind) -> Result<ModelFile, LabError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
+    let (model, places) = parse_placed(&text, gyro).map_err(|e| placed(path, e))?;
+    Ok(ModelFile {
+        model,
+        path: path.to_owned(),
+        text,
+        places,
+    })
+}
+
+/// A model file's error as the lab's, at its place in `path`.
+fn placed(path: &Path, e: ModelFileError) -> LabError {
     let at = |line, column, msg| {
         LabError::at(
             path,
@@ -23,7 +57,7 @@ pub fn read_model(path: &Path, gyro: GyroKind) -> Result<Model, LabError> {
             msg,
         )
     };
-    parse(&text, gyro).map_err(|e| match e {
+    match e {
         ModelFileError::At { line, column, msg } => at(line, column, msg),
         ModelFileError::Whole(msg) => LabError::input(path, msg),
         ModelFileError::OtherGyro {
@@ -40,7 +74,7 @@ pub fn read_model(path: &Path, gyro: GyroKind) -> Result<Model, LabError> {
                 asked.name()
             ),
         ),
-    })
+    }
 }
 
 /// Writes a model file, `comment` as `#` lines before it.

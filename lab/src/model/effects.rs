@@ -21,6 +21,11 @@
 //! | thermal_difference_squared | k3 dT^2/3600 | t_mono_a_c, t_mono_b_c |
 //! | case_temperature | k4 (T_K - 20)/3600 | t_case_c |
 //! | warm_up | A (1 - exp(-t/tau))/3600, t since power-on | - |
+//! | bias_temperature | b (T - 20)/3600 (FOG coil; docs/fog.md, thermal bias) | temp_c |
+//! | shupe | s dT/dt /3600, dT/dt the coil temperature's rate (the least-squares slope over +-30 s) | temp_c |
+//!
+//! Each parameter has a physical range (ranges.rs): a fit outside it is
+//! not that effect.
 
 use super::gyro_kind::GyroKind;
 use super::inputs::Inputs;
@@ -41,6 +46,8 @@ pub enum Effect {
     ThermalDifferenceSquared,
     CaseTemperature,
     WarmUp,
+    BiasTemperature,
+    Shupe,
 }
 
 /// An effect's contribution for a non-linear parameter: its columns (deg/s
@@ -51,10 +58,11 @@ pub struct Basis {
 }
 
 const PPM: f64 = 1e-6;
-const DPH: f64 = 1.0 / 3600.0;
+/// deg/s per deg/h.
+pub const DPH: f64 = 1.0 / 3600.0;
 
 impl Effect {
-    pub const ALL: [Effect; 12] = [
+    pub const ALL: [Effect; 14] = [
         Effect::Bias,
         Effect::ScaleFactorError,
         Effect::ScaleFactorAsymmetry,
@@ -67,6 +75,8 @@ impl Effect {
         Effect::ThermalDifferenceSquared,
         Effect::CaseTemperature,
         Effect::WarmUp,
+        Effect::BiasTemperature,
+        Effect::Shupe,
     ];
 
     pub fn name(self) -> &'static str {
@@ -83,6 +93,8 @@ impl Effect {
             Effect::ThermalDifferenceSquared => "thermal_difference_squared",
             Effect::CaseTemperature => "case_temperature",
             Effect::WarmUp => "warm_up",
+            Effect::BiasTemperature => "bias_temperature",
+            Effect::Shupe => "shupe",
         }
     }
 
@@ -105,14 +117,38 @@ impl Effect {
         Effect::ScaleFactorKnee.nonlinear_param() == Some(param)
     }
 
-    /// The effects of each gyro's physics: lock-in belongs to the RLG,
-    /// vibration rectification to the closed-loop FOG; the rest to both.
+    /// The effects of each gyro's physics: lock-in belongs to the RLG;
+    /// vibration rectification and the coil's thermal bias (linear in
+    /// its temperature, and the Shupe effect) to the closed-loop FOG; the
+    /// rest to both.
     pub fn applies_to(self, g: GyroKind) -> bool {
         match self {
             Effect::LockIn => g == GyroKind::Rlg,
-            Effect::VibrationRectification => g == GyroKind::Fog,
+            Effect::VibrationRectification | Effect::BiasTemperature | Effect::Shupe => {
+                g == GyroKind::Fog
+            }
             _ => true,
         }
+    }
+
+    /// Effects that scale with the input rate: a run that never turns
+    /// (the input is only the Earth-rate component) cannot show them,
+    /// whatever a fit says (physics.md 1.6: at rest a temperature-shaped
+    /// bias is a bias, not a scale factor).
+    pub fn needs_rotation(self) -> bool {
+        matches!(
+            self,
+            Effect::ScaleFactorError
+                | Effect::ScaleFactorAsymmetry
+                | Effect::ScaleFactorTemperature
+                | Effect::ScaleFactorKnee
+                | Effect::LockIn
+        )
+    }
+
+    /// Free parameters (linear and non-linear).
+    pub fn dof(self) -> usize {
+        self.linear_params().len() + usize::from(self.nonlinear_param().is_some())
     }
 
     /// Linear parameters, in the order of the basis columns.
@@ -130,6 +166,8 @@ impl Effect {
             Effect::ThermalDifferenceSquared => &["dph_per_c2"],
             Effect::CaseTemperature => &["dph_per_c"],
             Effect::WarmUp => &["amplitude_dph"],
+            Effect::BiasTemperature => &["dph_per_c"],
+            Effect::Shupe => &["dph_per_c_per_s"],
         }
     }
 
@@ -153,7 +191,10 @@ impl Effect {
     /// The run columns the effect needs, and whether `inp` has them.
     pub fn needs(self) -> &'static [Column] {
         match self {
-            Effect::ScaleFactorTemperature | Effect::ScaleFactorKnee => &[Column::Temp],
+            Effect::ScaleFactorTemperature
+            | Effect::ScaleFactorKnee
+            | Effect::BiasTemperature
+            | Effect::Shupe => &[Column::Temp],
             Effect::ThermalDifference
             | Effect::ThermalGradient
             | Effect::ThermalDifferenceSquared => &[Column::MonoA, Column::MonoB],
@@ -164,7 +205,10 @@ impl Effect {
 
     pub fn available(self, inp: &Inputs) -> bool {
         match self {
-            Effect::ScaleFactorTemperature | Effect::ScaleFactorKnee => inp.temp.is_some(),
+            Effect::ScaleFactorTemperature
+            | Effect::ScaleFactorKnee
+            | Effect::BiasTemperature
+            | Effect::Shupe => inp.temp.is_some(),
             Effect::ThermalDifference
             | Effect::ThermalGradient
             | Effect::ThermalDifferenceSquared => inp.dt.is_some(),
@@ -201,6 +245,11 @@ impl Effect {
                 vec![col(&|k| DPH * (c[k] - 20.0))]
             }
             Effect::WarmUp => vec![col(&|k| DPH * (1.0 - (-inp.t[k] / x.max(1e-9)).exp()))],
+            Effect::BiasTemperature => vec![col(&|k| DPH * (temp[k] - 20.0))],
+            Effect::Shupe => {
+                let g = inp.temp_rate.as_ref().unwrap_or(&zeros);
+                vec![col(&|k| DPH * g[k])]
+            }
         };
         let offset = (self == Effect::LockIn).then(|| col(&|k| lock_in_output(w[k], x) - w[k]));
         Basis { cols, offset }
@@ -254,11 +303,13 @@ impl Effect {
                 g
             }
             Effect::WarmUp => {
-                // From 5 minutes (a gyro warms up over minutes to hours; a
+                // From 2 minutes (a gyro warms up over minutes to hours; a
                 // shorter warm-up is a bias after its first minutes, and
-                // reads as one) to twice the record.
-                let span = inp.t.last().copied().unwrap_or(1.0).max(300.0);
-                log(300.0, span.max(600.0) * 2.0, 25)
+                // reads as one) to the record's length: a warm-up must
+                // settle inside the record to be told from a drift
+                // (ranges.rs).
+                let span = inp.t.last().copied().unwrap_or(1.0).max(240.0);
+                log(120.0, span, 28)
             }
             Effect::LockIn => {
                 let wmax = inp.w.iter().fold(0.0f64, |a, x| a.max(x.abs()));

@@ -20,6 +20,7 @@
 use super::effects::Effect;
 use super::gyro_kind::GyroKind;
 use super::gyro_model::{Model, ModelEffect};
+use super::ranges::{domain_error, Extent};
 use std::collections::BTreeMap;
 
 pub const VERSION: u16 = 1;
@@ -79,13 +80,37 @@ struct RawEffect {
     params: BTreeMap<String, toml::Value>,
 }
 
+/// Where each parameter's value starts in the text (byte offsets), by name.
+pub type Places = BTreeMap<String, usize>;
+
+/// The byte offset of the value of `key` inside the table text at `span`
+/// (its `key = value` line), else the table's start.
+fn value_offset(text: &str, span: &std::ops::Range<usize>, key: &str) -> usize {
+    let body = &text[span.start.min(text.len())..span.end.min(text.len())];
+    let mut off = span.start;
+    for line in body.split_inclusive('\n') {
+        let trimmed = line.trim_start();
+        let lead = line.len() - trimmed.len();
+        if let Some(rest) = trimmed.strip_prefix(key) {
+            let after = rest.trim_start();
+            if let Some(v) = after.strip_prefix('=') {
+                let v_lead = v.len() - v.trim_start().len();
+                return off + lead + key.len() + (rest.len() - after.len()) + 1 + v_lead;
+            }
+        }
+        off += line.len();
+    }
+    span.start
+}
+
 /// One `[[effect]]` table of a model of the `gyro`: a named effect of
-/// the library, with every parameter it has and no other.
+/// the library, with every parameter it has and no other, each inside its
+/// domain (ranges.rs); and where its values are.
 fn effect(
     text: &str,
     e: toml::Spanned<RawEffect>,
     gyro: GyroKind,
-) -> Result<ModelEffect, ModelFileError> {
+) -> Result<(ModelEffect, Places), ModelFileError> {
     let at = |s: std::ops::Range<usize>, msg: String| ModelFileError::at(text, s.start, msg);
     let span = e.span();
     let e = e.into_inner();
@@ -107,6 +132,7 @@ fn effect(
         ));
     }
     let mut params = BTreeMap::new();
+    let mut places = Places::new();
     for (k, v) in &e.params {
         if !effect.params().contains(&k.as_str()) {
             return Err(at(
@@ -118,15 +144,27 @@ fn effect(
             ));
         }
         let x = v.as_float().or(v.as_integer().map(|i| i as f64));
+        let place = value_offset(text, &span, k);
         match x {
-            Some(x) if x.is_finite() => params.insert(k.clone(), x),
+            Some(x) if x.is_finite() => {
+                if let Some(why) = domain_error(effect, k, x, None) {
+                    return Err(ModelFileError::at(
+                        text,
+                        place,
+                        format!("effect `{n}`: {why}"),
+                    ));
+                }
+                params.insert(k.clone(), x)
+            }
             _ => {
-                return Err(at(
-                    span.clone(),
+                return Err(ModelFileError::at(
+                    text,
+                    place,
                     format!("effect `{n}`: parameter `{k}` is not a finite number"),
                 ))
             }
         };
+        places.insert(k.clone(), place);
     }
     for p in effect.params() {
         if !params.contains_key(p) {
@@ -136,11 +174,17 @@ fn effect(
             ));
         }
     }
-    Ok(ModelEffect { effect, params })
+    Ok((ModelEffect { effect, params }, places))
 }
 
 /// Reads and checks the text of a model file for a gyro of kind `expect`.
 pub fn parse(text: &str, expect: GyroKind) -> Result<Model, ModelFileError> {
+    parse_placed(text, expect).map(|(m, _)| m)
+}
+
+/// [`parse`], with where each effect's parameter values are in the text
+/// (for the checks that need the run, [`check_on_run`]).
+pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Vec<Places>), ModelFileError> {
     let raw: RawModel = toml::from_str(text).map_err(|e| {
         let msg = e.message().replace('\n', " ");
         match e.span() {
@@ -181,16 +225,44 @@ pub fn parse(text: &str, expect: GyroKind) -> Result<Model, ModelFileError> {
             asked: expect,
         });
     }
-    let effects = raw
+    let (effects, places): (Vec<ModelEffect>, Vec<Places>) = raw
         .effect
         .into_iter()
         .map(|e| effect(text, e, gyro))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(Model {
-        gyro,
-        nominal: raw.nominal,
-        effects,
-    })
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .unzip();
+    Ok((
+        Model {
+            gyro,
+            nominal: raw.nominal,
+            effects,
+        },
+        places,
+    ))
+}
+
+/// The domains that depend on the run (a knee inside the temperatures it
+/// covers): the first parameter outside, at its place in `text`.
+pub fn check_on_run(
+    text: &str,
+    model: &Model,
+    places: &[Places],
+    extent: &Extent,
+) -> Result<(), ModelFileError> {
+    for (e, pl) in model.effects.iter().zip(places) {
+        for (k, v) in &e.params {
+            if let Some(why) = domain_error(e.effect, k, *v, Some(extent)) {
+                let off = pl.get(k).copied().unwrap_or(0);
+                return Err(ModelFileError::at(
+                    text,
+                    off,
+                    format!("effect `{}`: {why}", e.effect.name()),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The model as a model file's text.

@@ -4,6 +4,48 @@
 
 use crate::numerics::thermal_difference::dt_and_gradient;
 
+/// Half width of the temperature rate's slope, s: wide enough to average
+/// a sensor's quantization and noise, short against a coil's thermal lag
+/// (minutes).
+pub const RATE_HALF_WIDTH_S: f64 = 30.0;
+
+/// The least-squares slope of `x` over `t` within `half` s either side of
+/// each row (fewer rows at the ends), per second. Cumulative sums: O(n).
+pub fn centered_slope(t: &[f64], x: &[f64], half: f64) -> Vec<f64> {
+    let n = t.len();
+    let t0 = t.first().copied().unwrap_or(0.0);
+    let mut c = vec![[0.0f64; 5]; n + 1];
+    for k in 0..n {
+        let u = t[k] - t0;
+        let p = c[k];
+        c[k + 1] = [
+            p[0] + 1.0,
+            p[1] + u,
+            p[2] + u * u,
+            p[3] + x[k],
+            p[4] + u * x[k],
+        ];
+    }
+    let (mut lo, mut hi) = (0usize, 0usize);
+    (0..n)
+        .map(|k| {
+            while t[lo] < t[k] - half {
+                lo += 1;
+            }
+            while hi < n && t[hi] <= t[k] + half {
+                hi += 1;
+            }
+            let s: Vec<f64> = (0..5).map(|j| c[hi][j] - c[lo][j]).collect();
+            let den = s[0] * s[2] - s[1] * s[1];
+            if s[0] < 2.0 || den <= 1e-12 * s[0] * s[2].max(1e-300) {
+                0.0
+            } else {
+                (s[0] * s[4] - s[1] * s[3]) / den
+            }
+        })
+        .collect()
+}
+
 /// The run's inputs the effects are built from, one value per row.
 #[derive(Clone, Debug, Default)]
 pub struct Inputs {
@@ -11,8 +53,11 @@ pub struct Inputs {
     pub t: Vec<f64>,
     /// Reference rate, deg/s.
     pub w: Vec<f64>,
-    /// Main temperature sensor (FOG coil), degC.
+    /// Main temperature sensor (FOG coil), degC, and its rate of change
+    /// (the least-squares slope over [`RATE_HALF_WIDTH_S`] either side),
+    /// degC/s.
     pub temp: Option<Vec<f64>>,
+    pub temp_rate: Option<Vec<f64>>,
     /// Monoblock difference dT (clamped to +-32 degC as the firmware does)
     /// and its filtered derivative, degC and degC/s.
     pub dt: Option<Vec<f64>>,
@@ -42,6 +87,9 @@ impl Inputs {
             }
             None => (None, None),
         };
+        let temp_rate = temp
+            .as_ref()
+            .map(|x| centered_slope(&t, x, RATE_HALF_WIDTH_S));
         let acc_derived = acc.is_none();
         let acc = acc.unwrap_or_else(|| {
             // Central differences (one-sided at the ends).
@@ -61,6 +109,7 @@ impl Inputs {
             t,
             w,
             temp,
+            temp_rate,
             dt,
             grad,
             case,

@@ -3,13 +3,15 @@
 //! thermal chamber (chamber.rs), the FOG scale-factor rig (scale_factor_rig.rs),
 //! RLG fringes near lock-in (fringe.rs), a gyro model with the project's
 //! noise (model_run.rs), records of known noise terms (noise_run.rs, and
-//! by other algorithms independent_noise.rs) and the byte stream a board
-//! sends (board_stream.rs).
+//! by other algorithms independent_noise.rs), a second generator written
+//! apart from the project's for discovery's held-out set (heldout_run.rs)
+//! and the byte stream a board sends (board_stream.rs).
 
 pub mod board_stream;
 pub mod chamber;
 pub mod fog_run;
 pub mod fringe;
+pub mod heldout_run;
 pub mod independent_noise;
 pub mod model_run;
 pub mod noise_run;

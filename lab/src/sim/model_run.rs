@@ -1,8 +1,10 @@
 //! Runs with known effects: a truth model (the effects of
 //! model/effects.rs) evaluated on a test profile, plus the project's noise
-//! generator (gyro_sim::noise) and its thermal simulators (gyro_sim's
-//! coil, and the RLG chamber of chamber.rs). `simulate run` writes them;
-//! the discovery bench and tests draw them.
+//! generator (gyro_sim::noise: white, flicker and rate random walk) and its
+//! thermal simulators (gyro_sim's coil, and the RLG chamber of
+//! chamber.rs); optionally disturbances the library has no effect for
+//! ([`Extra`]). `simulate run` writes them; the discovery bench and tests
+//! draw them.
 
 use super::chamber::{air_temperature, earth_component_dps, ChamberProfile};
 use crate::model::gyro_kind::GyroKind;
@@ -37,12 +39,18 @@ pub enum TestProfile {
     /// FOG under one constant vibration level: rectification looks like a
     /// bias.
     ConstantVibration,
+    /// FOG at rest in a chamber: 20 -> +50 -> -10 -> 20 degC at 1 degC/min
+    /// with 30 min soaks (the coil 600 s behind the air, its sensor 30 s
+    /// behind the coil, read at 1/128 degC); 1 s rows, 3.7 h. The coil's
+    /// temperature and its rate of change move apart (ramps and soaks).
+    FogChamber,
 }
 
 impl TestProfile {
     pub fn gyro(self) -> GyroKind {
         match self {
             TestProfile::Chamber | TestProfile::Lockin => GyroKind::Rlg,
+            TestProfile::FogChamber => GyroKind::Fog,
             _ => GyroKind::Fog,
         }
     }
@@ -54,16 +62,68 @@ impl TestProfile {
             TestProfile::Chamber => (1.0, 6.0 * 3600.0),
             TestProfile::Lockin => (0.1, 1800.0),
             TestProfile::Vibration | TestProfile::ConstantVibration => (0.005, 600.0),
+            TestProfile::FogChamber => (1.0, FOG_CHAMBER_S),
         }
     }
 }
 
-/// Noise of the simulated gyro: white rate (deg/sqrt(h)) and bias
-/// instability (deg/h).
+/// Length of the FOG chamber profile, s.
+pub const FOG_CHAMBER_S: f64 = 600.0 + 120.0 * 60.0 + 3.0 * 1800.0;
+
+/// Noise of the simulated gyro: white rate (deg/sqrt(h)), bias
+/// instability (deg/h) and rate random walk (deg/h/sqrt(h)).
 #[derive(Clone, Copy, Debug)]
 pub struct TrialNoise {
     pub arw_dpsh: f64,
     pub bias_instability_dph: f64,
+    pub rate_random_walk_dphsh: f64,
+}
+
+/// A disturbance no effect of the library describes.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum Extra {
+    /// c w^2, deg/h per (deg/s)^2.
+    RateSquared(f64),
+    /// c w^3, deg/h per (deg/s)^3.
+    RateCubed(f64),
+    /// The bias steps by `dph` at `at_s`.
+    BiasStep { at_s: f64, dph: f64 },
+    /// A bias growing linearly in time, deg/h per hour.
+    RateRamp(f64),
+    /// k d2T/dt2 of the main (FOG) or case (RLG) temperature, deg/h per
+    /// degC/s^2.
+    TempCurvature(f64),
+}
+
+impl Extra {
+    /// Its contribution, deg/s, on `inp`.
+    pub fn contribution(&self, inp: &Inputs) -> Vec<f64> {
+        use crate::model::inputs::{centered_slope, RATE_HALF_WIDTH_S};
+        let d = 1.0 / 3600.0;
+        match *self {
+            Extra::RateSquared(c) => inp.w.iter().map(|w| c * d * w * w).collect(),
+            Extra::RateCubed(c) => inp.w.iter().map(|w| c * d * w * w * w).collect(),
+            Extra::BiasStep { at_s, dph } => inp
+                .t
+                .iter()
+                .map(|&t| if t >= at_s { dph * d } else { 0.0 })
+                .collect(),
+            Extra::RateRamp(r) => inp.t.iter().map(|t| r * d * t / 3600.0).collect(),
+            Extra::TempCurvature(k) => {
+                let temp = inp.temp.as_ref().or(inp.case.as_ref());
+                match temp {
+                    Some(x) => {
+                        let r = centered_slope(&inp.t, x, RATE_HALF_WIDTH_S);
+                        centered_slope(&inp.t, &r, RATE_HALF_WIDTH_S)
+                            .iter()
+                            .map(|c| k * d * c)
+                            .collect()
+                    }
+                    None => vec![0.0; inp.len()],
+                }
+            }
+        }
+    }
 }
 
 impl TrialNoise {
@@ -73,10 +133,12 @@ impl TrialNoise {
             GyroKind::Fog => Self {
                 arw_dpsh: 0.005,
                 bias_instability_dph: 0.005,
+                rate_random_walk_dphsh: 0.0,
             },
             GyroKind::Rlg => Self {
                 arw_dpsh: 0.003,
                 bias_instability_dph: 0.003,
+                rate_random_walk_dphsh: 0.0,
             },
         }
     }
@@ -130,6 +192,47 @@ fn table(t: &[f64], dt: f64, dur: f64, rng: &mut Xoshiro256PlusPlus) -> ProfileI
         w: t.iter()
             .map(|&tk| rates[((tk - dt / 2.0) / 60.0) as usize % rates.len()])
             .collect(),
+        temp: Some(tc),
+        ..Default::default()
+    }
+}
+
+/// Air of the FOG chamber profile at time t: 10 min at 20 degC, then
+/// ramps at 1 degC/min to 50, -10 and 20 degC with 30 min soaks.
+fn fog_chamber_air(t: f64) -> f64 {
+    let pts = [20.0, 50.0, -10.0, 20.0];
+    let mut t0 = 600.0;
+    if t < t0 {
+        return pts[0];
+    }
+    for w in pts.windows(2) {
+        let ramp = (w[1] - w[0]).abs() * 60.0;
+        if t < t0 + ramp {
+            return w[0] + (w[1] - w[0]) * (t - t0) / ramp;
+        }
+        t0 += ramp;
+        if t < t0 + 1800.0 {
+            return w[1];
+        }
+        t0 += 1800.0;
+    }
+    pts[pts.len() - 1]
+}
+
+/// The FOG at rest in the chamber: the coil sensor read at 1/128 degC
+/// with 0.005 degC noise.
+fn fog_chamber(t: &[f64], dt: f64, rng: &mut Xoshiro256PlusPlus) -> ProfileInputs {
+    let mut coil = CoilThermal::new(20.0);
+    let tc = t
+        .iter()
+        .map(|&tk| {
+            let (_, sensor) = coil.step(dt, fog_chamber_air(tk - dt / 2.0));
+            let z: f64 = StandardNormal.sample(rng);
+            ((sensor + 0.005 * z) * 128.0).round() / 128.0
+        })
+        .collect();
+    ProfileInputs {
+        w: vec![earth_component_dps(0.0, 90.0, 48.0); t.len()],
         temp: Some(tc),
         ..Default::default()
     }
@@ -214,11 +317,24 @@ pub fn generate(
     seed: u64,
     timing: Option<(f64, f64)>,
 ) -> TrialRun {
-    let (dt, dur) = timing.unwrap_or(profile.default_timing());
+    generate_with(model, &[], profile, noise, seed, timing)
+}
+
+/// The inputs of `profile` for `seed` at (row period, duration): the same
+/// as [`generate`]'s.
+pub fn inputs_of(profile: TestProfile, seed: u64, timing: Option<(f64, f64)>) -> Inputs {
+    profile_inputs(profile, seed, timing.unwrap_or(profile.default_timing())).0
+}
+
+fn profile_inputs(
+    profile: TestProfile,
+    seed: u64,
+    (dt, dur): (f64, f64),
+) -> (Inputs, ProfileInputs) {
     let n = (dur / dt).round() as usize;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0xD15C_0FE2);
     let t: Vec<f64> = (0..n).map(|k| (k + 1) as f64 * dt).collect();
-    let p = match profile {
+    let mut p = match profile {
         TestProfile::Table => table(&t, dt, dur, &mut rng),
         TestProfile::ConstantRate => ProfileInputs {
             w: vec![50.0; n],
@@ -229,13 +345,36 @@ pub fn generate(
         TestProfile::Lockin => lockin(&t, dt),
         TestProfile::Vibration => vibration(&t, dt, false),
         TestProfile::ConstantVibration => vibration(&t, dt, true),
+        TestProfile::FogChamber => fog_chamber(&t, dt, &mut rng),
     };
+    let inputs = Inputs::new(
+        t,
+        std::mem::take(&mut p.w),
+        p.temp.take(),
+        p.mono.clone(),
+        p.case.clone(),
+        p.acc.clone(),
+    );
+    (inputs, p)
+}
+
+/// [`generate`] with disturbances outside the library added.
+pub fn generate_with(
+    model: &Model,
+    extras: &[Extra],
+    profile: TestProfile,
+    noise: TrialNoise,
+    seed: u64,
+    timing: Option<(f64, f64)>,
+) -> TrialRun {
+    let (dt, dur) = timing.unwrap_or(profile.default_timing());
+    let (inputs, p) = profile_inputs(profile, seed, (dt, dur));
     let acc_column = p.acc.is_some();
-    let inputs = Inputs::new(t, p.w, p.temp, p.mono.clone(), p.case.clone(), p.acc);
     let mut g = RateNoise::new(
         NoiseParams {
             n_dps_rts: NoiseParams::arw_from_dpsh(noise.arw_dpsh),
             b_dps: NoiseParams::b_from_dph(noise.bias_instability_dph),
+            k_dps_rts: NoiseParams::k_from_dphsh(noise.rate_random_walk_dphsh),
             // Bias instability up to a third of the record (as far as the
             // run's Allan deviation reaches): slower processes would only
             // add a turn-on bias, which no record can tell from a bias
@@ -246,11 +385,16 @@ pub fn generate(
         dt,
         seed,
     );
-    let rate: Vec<f64> = model
+    let mut rate: Vec<f64> = model
         .evaluate(&inputs)
         .iter()
         .map(|y| y + g.sample())
         .collect();
+    for x in extras {
+        for (r, c) in rate.iter_mut().zip(x.contribution(&inputs)) {
+            *r += c;
+        }
+    }
     TrialRun {
         inputs,
         rate,

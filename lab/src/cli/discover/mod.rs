@@ -5,16 +5,18 @@
 pub mod report;
 
 use crate::cli::args::{Json, Out};
-use crate::cli::model_file::{read_model, write_model};
+use crate::cli::model_file::{read_model_file, write_model};
 use crate::cli::output::write_report;
 use crate::data::residual_file;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
-use crate::model::discovery::{discover, Discovery, Run, SMOOTH_S, WINDOW_S};
+use crate::model::discovery::estimates::Estimate;
+use crate::model::discovery::{discover, Discovery, Run, WINDOW_S};
 use crate::model::effects::Effect;
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
+use crate::model::ranges::Extent;
 use crate::report::text::sig;
 use clap::{Args, ValueEnum};
 use std::collections::BTreeMap;
@@ -83,45 +85,72 @@ pub fn read_run(path: &Path) -> Result<Run, LabError> {
     })
 }
 
-#[derive(serde::Serialize)]
-struct FoundJson {
-    effect: Effect,
-    parameters: BTreeMap<&'static str, f64>,
-    parameter_intervals: BTreeMap<&'static str, [f64; 2]>,
-    delta_bic: f64,
-    explained_share: f64,
+/// An estimate's JSON: parameters and their 95 % intervals.
+fn estimate_json(e: &Estimate) -> serde_json::Value {
+    let parameters: BTreeMap<&str, f64> = e.params.iter().map(|p| (p.0, p.1)).collect();
+    let intervals: BTreeMap<&str, [f64; 2]> = e.params.iter().map(|p| (p.0, [p.2, p.3])).collect();
+    serde_json::json!({
+        "effect": e.effect,
+        "parameters": parameters,
+        "parameter_intervals": intervals,
+        "delta_bic": e.delta_bic,
+        "explained_share": e.explained_share,
+    })
 }
 
 /// The JSON of a discovery (docs/interfaces.md keys and more).
 pub fn json(d: &Discovery) -> serde_json::Value {
-    let found: Vec<FoundJson> = d
-        .found
+    let found: Vec<serde_json::Value> = d.found.iter().map(estimate_json).collect();
+    let carried: Vec<serde_json::Value> = d
+        .carried
         .iter()
-        .map(|e| FoundJson {
-            effect: e.effect,
-            parameters: e.params.iter().map(|p| (p.0, p.1)).collect(),
-            parameter_intervals: e.params.iter().map(|p| (p.0, [p.2, p.3])).collect(),
-            delta_bic: e.delta_bic,
-            explained_share: e.explained_share,
+        .map(|c| {
+            let mut j = estimate_json(&c.estimate);
+            j["why"] = c.why.clone().into();
+            j
         })
         .collect();
     let skipped: Vec<serde_json::Value> = d
         .skipped
         .iter()
-        .map(|(e, cols)| {
-            let names: Vec<&str> = cols.iter().map(|c| c.name()).collect();
-            serde_json::json!({"effect": e.name(), "missing": names})
+        .map(|s| {
+            let names: Vec<&str> = s.missing.iter().map(|c| c.name()).collect();
+            serde_json::json!({"effect": s.effect.name(), "missing": names, "reason": s.reason})
         })
         .collect();
+    let implausible: Vec<serde_json::Value> = d
+        .implausible
+        .iter()
+        .map(|i| {
+            let p: BTreeMap<&str, f64> = i.parameters.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+            let out: Vec<serde_json::Value> = i
+                .outside
+                .iter()
+                .map(|(k, v, r)| serde_json::json!({"parameter": k, "value": v, "range": [r.0, r.1]}))
+                .collect();
+            serde_json::json!({"effect": i.effect, "parameters": p, "outside": out})
+        })
+        .collect();
+    let n = &d.noise;
     serde_json::json!({
         "found": found,
         "gap_before_dph": d.gap_before_dph,
         "gap_after_dph": d.gap_after_dph,
         "noise_floor_dph": d.noise_floor_dph,
-        "ambiguous": d.selection.ambiguous,
+        "ambiguous": d.ambiguous,
+        "unexplained": d.unexplained,
+        "carried": carried,
+        "implausible": implausible,
+        "dropped": d.dropped,
         "skipped": skipped,
         "disagreements": d.disagreements,
-        "noise_inflation": d.selection.inflation,
+        "noise": {
+            "white_1s_dph": n.white.sqrt() * 3600.0,
+            "bias_instability_dph": n.flicker.sqrt() * 3600.0,
+            "rate_random_walk_dph_per_sqrt_h": n.random_walk.sqrt() * 3600.0 * 60.0,
+            "passes": d.passes,
+        },
+        "fallback": d.fallback,
         "windows": d.windows.len(),
         "gyro": d.gyro.name(),
     })
@@ -130,11 +159,18 @@ pub fn json(d: &Discovery) -> serde_json::Value {
 pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let t0 = std::time::Instant::now();
     let gyro = GyroKind::from(a.gyro);
-    let model = match &a.model {
-        Some(p) => read_model(p, gyro)?,
-        None => Model::ideal(gyro),
+    let file = match &a.model {
+        Some(p) => Some(read_model_file(p, gyro)?),
+        None => None,
     };
     let data = read_run(&a.data)?;
+    let model = match &file {
+        Some(f) => {
+            f.check_on_run(&run_extent(&data))?;
+            f.model.clone()
+        }
+        None => Model::ideal(gyro),
+    };
     // The model's own effects must be computable on this run.
     if let Some((e, cols)) = model.missing_inputs(&data.inputs).first() {
         return Err(LabError::input(
@@ -161,28 +197,46 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     Ok(())
 }
 
+/// What a run covers, for the model's domains that depend on it.
+fn run_extent(data: &Run) -> Extent {
+    let t = &data.inputs.t;
+    Extent {
+        record_s: t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0),
+        temp_c: data.inputs.temp.as_ref().map(|v| {
+            v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
+                (a.0.min(x), a.1.max(x))
+            })
+        }),
+    }
+}
+
 /// model.toml (the model with the effects found), residual.csv and the
 /// report, in `--out`.
 fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabError> {
     let out = &a.out.out;
     std::fs::create_dir_all(out).map_err(|e| LabError::io(out, e))?;
     let names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
-    write_model(
-        &out.join("model.toml"),
-        &d.model_after,
-        &format!(
-            "gyro-lab discover on {}: the model{} with {} added",
-            a.data.display(),
-            a.model
-                .as_ref()
-                .map_or(" (ideal)".into(), |p| format!(" {}", p.display())),
-            if names.is_empty() {
-                "nothing".to_owned()
-            } else {
-                names.join(", ")
-            }
-        ),
-    )?;
+    let carried: Vec<String> = d
+        .carried
+        .iter()
+        .map(|c| format!("{} ({})", c.estimate.effect.name(), c.why))
+        .collect();
+    let mut comment = format!(
+        "gyro-lab discover on {}: the model{} with {} added",
+        a.data.display(),
+        a.model
+            .as_ref()
+            .map_or(" (ideal)".into(), |p| format!(" {}", p.display())),
+        if names.is_empty() {
+            "nothing named".to_owned()
+        } else {
+            names.join(", ")
+        }
+    );
+    if !carried.is_empty() {
+        comment.push_str(&format!("\ncarried, not named: {}", carried.join("; ")));
+    }
+    write_model(&out.join("model.toml"), &d.model_after, &comment)?;
     residual_file::write(
         &out.join("residual.csv"),
         &data.inputs.t,
@@ -191,6 +245,14 @@ fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabErr
     )?;
     write_report(&report::report(d, data, &a.data), &out.join("report.html"))?;
     Ok(())
+}
+
+fn params_text(e: &Estimate) -> String {
+    e.params
+        .iter()
+        .map(|(n, v, lo, hi)| format!("{n} {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi)))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn print_text(a: &DiscoverArgs, d: &Discovery) {
@@ -202,46 +264,91 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
         d.gap_before_dph,
         d.noise_floor_dph
     );
-    for s in d.disagreements.iter().take(8) {
-        println!(
-            "  disagrees {:.0} .. {:.0} s (peak {:+.4} deg/h over {} s)",
-            s.from_s, s.to_s, s.peak_dph, SMOOTH_S
-        );
-    }
-    if d.disagreements.len() > 8 {
-        println!(
-            "  ... {} more stretches (in the JSON and the report)",
-            d.disagreements.len() - 8
-        );
-    }
-    for (e, cols) in &d.skipped {
-        let names: Vec<&str> = cols.iter().map(|c| c.name()).collect();
-        println!("skipped {}: the run has no {}", e.name(), names.join(", "));
-    }
-    if d.found.is_empty() && d.selection.ambiguous.is_empty() {
-        println!("nothing is missing: no effect of the library beats the noise");
+    for s in &d.skipped {
+        let names: Vec<&str> = s.missing.iter().map(|c| c.name()).collect();
+        if names.is_empty() {
+            println!("skipped {}: {}", s.effect.name(), s.reason);
+        } else {
+            println!(
+                "skipped {}: the run has no {}",
+                s.effect.name(),
+                names.join(", ")
+            );
+        }
     }
     for e in &d.found {
-        let p: Vec<String> = e
-            .params
-            .iter()
-            .map(|(n, v, lo, hi)| format!("{n} {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi)))
-            .collect();
         println!(
             "found {}: {} (delta BIC {:.1}, explains {:.1} % of the residual variance)",
             e.effect.name(),
-            p.join(", "),
+            params_text(e),
             e.delta_bic,
             100.0 * e.explained_share
         );
     }
-    for g in &d.selection.ambiguous {
+    for c in &d.carried {
         println!(
-            "ambiguous: {} (correlation {:.3}): {}",
+            "carried {}: {} ({})",
+            c.estimate.effect.name(),
+            params_text(&c.estimate),
+            c.why
+        );
+    }
+    for g in &d.ambiguous {
+        println!(
+            "ambiguous: {} (correlation {:.3}), carried as {}: {}",
             Effect::names(&g.effects, " / "),
             g.correlation.get(1).copied().unwrap_or(1.0),
+            g.carried_as.name(),
             g.suggestion
         );
+    }
+    for i in &d.implausible {
+        let o: Vec<String> = i
+            .outside
+            .iter()
+            .map(|(k, v, r)| format!("{k} {} outside {} .. {}", sig(*v), sig(r.0), sig(r.1)))
+            .collect();
+        println!(
+            "implausible {}: {} (not named: no {} is that)",
+            i.effect.name(),
+            o.join(", "),
+            i.effect.name()
+        );
+    }
+    match &d.unexplained {
+        Some(u) => {
+            println!(
+                "no effect of the library explains this: {:.4} deg/h above the noise ({})",
+                u.excess_dph,
+                u.carried_by.join("; ")
+            );
+            for s in u.spans.iter().take(8) {
+                println!(
+                    "  {:.0} .. {:.0} s (peak {:+.4} deg/h)",
+                    s.from_s, s.to_s, s.peak_dph
+                );
+            }
+            if u.spans.len() > 8 {
+                println!(
+                    "  ... {} more spans (in the JSON and the report)",
+                    u.spans.len() - 8
+                );
+            }
+            let c: Vec<String> = u
+                .correlates
+                .iter()
+                .take(4)
+                .map(|c| format!("{} (r = {:+.2})", c.input, c.correlation))
+                .collect();
+            println!("  it follows most: {}", c.join(", "));
+        }
+        None if d.found.is_empty() && d.ambiguous.is_empty() => {
+            println!("nothing is missing: no effect of the library beats the noise, and nothing stands out of it");
+        }
+        None => {}
+    }
+    if let Some(f) = &d.fallback {
+        println!("note: {f}");
     }
     println!(
         "gap {:.4} -> {:.4} deg/h; written {}, residual.csv, report.html",

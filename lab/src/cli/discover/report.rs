@@ -1,6 +1,7 @@
 //! The discovery report (on the lab's one report writer, report/).
 
 use crate::cli::adev_plot::adev_series;
+use crate::model::discovery::estimates::Estimate;
 use crate::model::discovery::{Discovery, Run, WINDOW_S};
 use crate::model::effects::Effect;
 use crate::noise::terms;
@@ -90,26 +91,33 @@ fn allan_section(r: &mut Report, d: &Discovery) {
     }
 }
 
-/// The table of the effects found.
+fn params_cell(e: &Estimate) -> String {
+    e.params
+        .iter()
+        .map(|(n, v, lo, hi)| format!("{n} = {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi)))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// The table of the effects found and carried.
 fn found_section(r: &mut Report, d: &Discovery) {
     r.heading("Effects found");
     if d.found.is_empty() {
-        r.paragraph("Nothing is missing: no effect of the library beats the noise.");
+        r.paragraph(if d.unexplained.is_some() {
+            "No effect of the library is named (what the residual holds is below, under \"Unexplained\")."
+        } else if d.ambiguous.is_empty() {
+            "Nothing is missing: no effect of the library beats the noise, and nothing stands out of it."
+        } else {
+            "No effect is named: the run cannot tell apart the effects below."
+        });
     } else {
         let rows: Vec<Vec<String>> = d
             .found
             .iter()
             .map(|e| {
-                let p: Vec<String> = e
-                    .params
-                    .iter()
-                    .map(|(n, v, lo, hi)| {
-                        format!("{n} = {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi))
-                    })
-                    .collect();
                 vec![
                     e.effect.name().into(),
-                    p.join("; "),
+                    params_cell(e),
                     format!("{:.1}", e.delta_bic),
                     format!("{:.1} %", 100.0 * e.explained_share),
                 ]
@@ -118,12 +126,91 @@ fn found_section(r: &mut Report, d: &Discovery) {
         r.table(
             &[
                 "effect",
-                "parameters (95 % interval)",
-                "BIC change",
+                "parameters (95 % interval, the residual's coloured noise included)",
+                "BIC change without it",
                 "share of residual variance",
             ],
             &rows,
         );
+    }
+    if !d.carried.is_empty() {
+        r.paragraph("Carried in the model written, not named:");
+        let rows: Vec<Vec<String>> = d
+            .carried
+            .iter()
+            .map(|c| {
+                vec![
+                    c.estimate.effect.name().into(),
+                    params_cell(&c.estimate),
+                    c.why.clone(),
+                ]
+            })
+            .collect();
+        r.table(&["effect", "parameters (95 % interval)", "why"], &rows);
+    }
+    if let Some(f) = &d.fallback {
+        r.note(f);
+    }
+}
+
+/// What no effect of the library explains.
+fn unexplained_section(r: &mut Report, d: &Discovery) {
+    r.heading("Unexplained");
+    let Some(u) = &d.unexplained else {
+        r.paragraph(&format!(
+            "The model explains the data to its noise: nothing stands out of the residual's noise \
+             (white {} deg/h in 1 s, bias instability {} deg/h, rate random walk {} deg/h/sqrt(h), from the Allan \
+             analysis of the residual).",
+            num(d.noise.white.sqrt() * DPH),
+            num(d.noise.flicker.sqrt() * DPH),
+            num(d.noise.random_walk.sqrt() * DPH * 60.0)
+        ));
+        return;
+    };
+    r.paragraph(&format!(
+        "No effect of the library explains this: {} deg/h (RMS of 1 s means) stays above the noise after the model, \
+         carried by {}.",
+        num(u.excess_dph),
+        u.carried_by.join("; ")
+    ));
+    if !u.spans.is_empty() {
+        let rows: Vec<Vec<String>> = u
+            .spans
+            .iter()
+            .map(|s| vec![sig(s.from_s), sig(s.to_s), num(s.peak_dph)])
+            .collect();
+        r.table(
+            &[
+                "from, s",
+                "to, s",
+                "peak residual after the model (60 s mean), deg/h",
+            ],
+            &rows,
+        );
+    }
+    let rows: Vec<Vec<String>> = u
+        .correlates
+        .iter()
+        .map(|c| vec![c.input.clone(), format!("{:+.3}", c.correlation)])
+        .collect();
+    r.table(&["input", "correlation with the unexplained part"], &rows);
+    if !d.implausible.is_empty() {
+        let rows: Vec<Vec<String>> = d
+            .implausible
+            .iter()
+            .map(|i| {
+                let o: Vec<String> = i
+                    .outside
+                    .iter()
+                    .map(|(k, v, rg)| {
+                        format!("{k} = {} (range {} .. {})", sig(*v), sig(rg.0), sig(rg.1))
+                    })
+                    .collect();
+                vec![i.effect.name().into(), o.join("; ")]
+            })
+            .collect();
+        r.paragraph("Fits outside their physical range, not named:");
+        r.table(&["effect", "parameters outside their range"], &rows);
     }
 }
 
@@ -167,16 +254,16 @@ fn effect_plots(r: &mut Report, d: &Discovery, run: &Run) {
 
 /// Groups of effects the run cannot tell apart, and the effects skipped.
 fn ambiguous_and_skipped(r: &mut Report, d: &Discovery) {
-    if !d.selection.ambiguous.is_empty() {
+    if !d.ambiguous.is_empty() {
         r.heading("Effects this run cannot tell apart");
         let rows: Vec<Vec<String>> = d
-            .selection
             .ambiguous
             .iter()
             .map(|g| {
                 vec![
                     Effect::names(&g.effects, " / "),
                     format!("{:.3}", g.correlation.get(1).copied().unwrap_or(1.0)),
+                    g.carried_as.name().into(),
                     g.suggestion.clone(),
                 ]
             })
@@ -185,6 +272,7 @@ fn ambiguous_and_skipped(r: &mut Report, d: &Discovery) {
             &[
                 "effects",
                 "correlation",
+                "carried as",
                 "a test profile that separates them",
             ],
             &rows,
@@ -192,12 +280,16 @@ fn ambiguous_and_skipped(r: &mut Report, d: &Discovery) {
     }
     if !d.skipped.is_empty() {
         r.note(&format!(
-            "Skipped (the run lacks their inputs): {}.",
+            "Skipped: {}.",
             d.skipped
                 .iter()
-                .map(|(e, c)| {
-                    let names: Vec<&str> = c.iter().map(|c| c.name()).collect();
-                    format!("{} ({})", e.name(), names.join(", "))
+                .map(|s| {
+                    let names: Vec<&str> = s.missing.iter().map(|c| c.name()).collect();
+                    if names.is_empty() {
+                        format!("{} ({})", s.effect.name(), s.reason)
+                    } else {
+                        format!("{} (the run lacks {})", s.effect.name(), names.join(", "))
+                    }
                 })
                 .collect::<Vec<_>>()
                 .join("; ")
@@ -221,6 +313,7 @@ pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
     residual_section(&mut r, d);
     allan_section(&mut r, d);
     found_section(&mut r, d);
+    unexplained_section(&mut r, d);
     effect_plots(&mut r, d, run);
     ambiguous_and_skipped(&mut r, d);
     r

@@ -3,6 +3,7 @@
 
 pub mod chamber;
 pub mod fog;
+pub mod heldout;
 pub mod lockin;
 pub mod run;
 pub mod scale_factor;
@@ -22,6 +23,8 @@ pub enum SimulateCmd {
     ScaleFactor(scale_factor::SimulateArgs),
     /// A gyro model (model.toml) on a test profile with the project's noise: a run with known effects.
     Run(run::SimulateRunArgs),
+    /// The second, independent generator's held-out set for discovery (runs and truth.json).
+    Heldout(heldout::HeldOutArgs),
 }
 
 pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
@@ -31,5 +34,6 @@ pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
         SimulateCmd::Chamber(a) => chamber::run(a),
         SimulateCmd::ScaleFactor(a) => scale_factor::run(a),
         SimulateCmd::Run(a) => run::run(a),
+        SimulateCmd::Heldout(a) => heldout::run(a),
     }
 }

@@ -35,6 +35,9 @@ pub enum TestProfileArg {
     /// FOG under one constant vibration level: rectification looks like a
     /// bias.
     ConstantVibration,
+    /// FOG at rest in a chamber: 20 -> +50 -> -10 -> 20 degC at 1 degC/min
+    /// with 30 min soaks (coil 600 s behind the air); 1 s rows, 3.7 h.
+    FogChamber,
 }
 
 impl From<TestProfileArg> for TestProfile {
@@ -46,6 +49,7 @@ impl From<TestProfileArg> for TestProfile {
             TestProfileArg::Lockin => TestProfile::Lockin,
             TestProfileArg::Vibration => TestProfile::Vibration,
             TestProfileArg::ConstantVibration => TestProfile::ConstantVibration,
+            TestProfileArg::FogChamber => TestProfile::FogChamber,
         }
     }
 }
@@ -110,6 +114,9 @@ pub struct SimulateRunArgs {
     pub arw_dpsh: Option<f64>,
     #[arg(long)]
     pub bias_instability_dph: Option<f64>,
+    /// Rate random walk, deg/h/sqrt(h) (default none).
+    #[arg(long)]
+    pub rate_random_walk_dphsh: Option<f64>,
     #[command(flatten)]
     pub seed: Seed,
     #[command(flatten)]
@@ -136,18 +143,23 @@ pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
             .bias_instability_dph
             .unwrap_or(nom.bias_instability_dph)
             .max(0.0),
+        rate_random_walk_dphsh: a
+            .rate_random_walk_dphsh
+            .unwrap_or(nom.rate_random_walk_dphsh)
+            .max(0.0),
     };
     let run = generate(&model, profile, noise, a.seed.seed, Some((dt, dur)));
     write(
         &run,
         &a.out.out,
         &format!(
-            "gyro-lab simulate run: profile {:?}, model {}, seed {}, ARW {} deg/sqrt(h), bias instability {} deg/h",
+            "gyro-lab simulate run: profile {:?}, model {}, seed {}, ARW {} deg/sqrt(h), bias instability {} deg/h, rate random walk {} deg/h/sqrt(h)",
             a.profile,
             a.model.display(),
             a.seed.seed,
             noise.arw_dpsh,
-            noise.bias_instability_dph
+            noise.bias_instability_dph,
+            noise.rate_random_walk_dphsh
         ),
     )?;
     let j = serde_json::json!({"rows": run.inputs.len(), "out": a.out.out});

@@ -1,48 +1,194 @@
 //! The windowed regression problem of discovery: the residual's window
-//! means against the window means of each effect's columns, the joint fit
-//! of a set of effects at their non-linear parameters, the search of those
-//! parameters, and the variance inflation for correlated noise.
+//! means against the window means of each term's columns, both whitened by
+//! the residual's noise model (noise_model.rs), so that a least-squares
+//! fit is the generalised one; the joint fit of a set of terms at their
+//! non-linear parameters, the search of those parameters, and the
+//! criterion (BIC on the whitened problem).
 
+use super::noise_model::Whitener;
+use super::normal::normal_solve;
+use super::terms::{Kind, Shape, Term};
 use super::windows::Windows;
-use crate::model::effects::Effect;
+use crate::model::effects::{Effect, DPH};
 use crate::model::inputs::Inputs;
-use crate::numerics::lsq::{wls, LsFit};
+use crate::model::ranges::Extent;
 use crate::numerics::search::{golden, grid_then_golden};
+use std::collections::HashMap;
 
-/// An effect in the fit, at its non-linear parameter.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Term {
-    pub effect: Effect,
-    pub x: f64,
+/// A term's columns (window means) and fixed part, unwhitened.
+pub struct Raw {
+    pub cols: Vec<Vec<f64>>,
+    pub offset: Option<Vec<f64>>,
 }
 
-/// The windowed problem.
+/// The windowed, whitened problem.
 pub struct Design<'a> {
     pub inp: &'a Inputs,
     pub win: &'a Windows,
+    pub extent: Extent,
     /// Window means of the residual, deg/s.
     pub r: Vec<f64>,
+    pub wh: Whitener,
+    /// The whitened residual.
+    pub y: Vec<f64>,
+    /// Step times offered to the fit (from transients.rs).
+    pub steps: Vec<f64>,
+    /// Variance inflation for the correlation the noise model leaves in
+    /// the whitened residual ([`inflation`]), at least 1.
+    pub phi: f64,
+    /// Whitened columns of the terms without a non-linear parameter.
+    fixed: HashMap<String, (Vec<Vec<f64>>, Option<Vec<f64>>)>,
 }
 
-/// A term's windowed columns and offset.
-type WBasis = (Vec<Vec<f64>>, Option<Vec<f64>>);
+/// A joint fit: coefficients (in the terms' order, their columns in
+/// turn) and the whitened residual and its sum of squares.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    pub coef: Vec<f64>,
+    pub resid: Vec<f64>,
+    pub sse: f64,
+}
 
-impl Design<'_> {
-    fn wbasis(&self, t: &Term) -> WBasis {
-        let b = t.effect.basis(self.inp, t.x);
+fn key(k: Kind) -> String {
+    format!("{k:?}")
+}
+
+impl<'a> Design<'a> {
+    pub fn new(
+        inp: &'a Inputs,
+        win: &'a Windows,
+        extent: Extent,
+        r: Vec<f64>,
+        wh: Whitener,
+        steps: Vec<f64>,
+    ) -> Self {
+        let y = wh.whiten(&r);
+        let mut d = Self {
+            inp,
+            win,
+            extent,
+            r,
+            wh,
+            y,
+            steps,
+            phi: 1.0,
+            fixed: HashMap::new(),
+        };
+        let mut kinds = vec![Kind::Constant];
+        kinds.extend(
+            Effect::ALL
+                .into_iter()
+                .filter(|e| e.nonlinear_param().is_none() && e.available(inp))
+                .map(Kind::Effect),
+        );
+        kinds.extend(
+            Shape::ALL
+                .into_iter()
+                .filter(|s| s.available(inp))
+                .map(Kind::Shape),
+        );
+        for k in kinds {
+            let raw = d.raw(&Term::of(k));
+            let w = d.whiten_raw(&raw);
+            d.fixed.insert(key(k), w);
+        }
+        d
+    }
+
+    /// Windows used by the fit.
+    pub fn n(&self) -> f64 {
+        self.wh.used() as f64
+    }
+
+    /// A term's columns and fixed part as window means (deg/s per unit).
+    pub fn raw(&self, t: &Term) -> Raw {
+        match t.kind {
+            Kind::Constant => Raw {
+                cols: vec![vec![DPH; self.win.len()]],
+                offset: None,
+            },
+            Kind::Step => Raw {
+                cols: vec![self
+                    .win
+                    .t
+                    .iter()
+                    .map(|&w| if w >= t.x { DPH } else { 0.0 })
+                    .collect()],
+                offset: None,
+            },
+            Kind::Shape(s) => Raw {
+                cols: vec![self.win.mean(&s.column(self.inp))],
+                offset: None,
+            },
+            Kind::Decay => Raw {
+                cols: vec![self
+                    .win
+                    .t
+                    .iter()
+                    .map(|&w| DPH * (-w / t.x.max(1e-9)).exp())
+                    .collect()],
+                offset: None,
+            },
+            Kind::Effect(Effect::WarmUp) => Raw {
+                // Smooth over a window (tau >= 2 min): its value at the
+                // window's mean time.
+                cols: vec![self
+                    .win
+                    .t
+                    .iter()
+                    .map(|&w| DPH * (1.0 - (-w / t.x.max(1e-9)).exp()))
+                    .collect()],
+                offset: None,
+            },
+            Kind::Effect(e) => {
+                let b = e.basis(self.inp, t.x);
+                Raw {
+                    cols: b.cols.iter().map(|c| self.win.mean(c)).collect(),
+                    offset: b.offset.map(|o| self.win.mean(&o)),
+                }
+            }
+        }
+    }
+
+    fn whiten_raw(&self, raw: &Raw) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
         (
-            b.cols.iter().map(|c| self.win.mean(c)).collect(),
-            b.offset.map(|o| self.win.mean(&o)),
+            raw.cols.iter().map(|c| self.wh.whiten(c)).collect(),
+            raw.offset.as_ref().map(|o| self.wh.whiten(o)),
         )
     }
 
-    /// Joint fit of `terms`: the least-squares fit (None without linear
-    /// columns) and the residual.
-    pub fn fit(&self, terms: &[Term]) -> Option<(Option<LsFit>, Vec<f64>)> {
+    /// A term's whitened columns and fixed part.
+    fn whitened(&self, t: &Term) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
+        if let Some(w) = self.fixed.get(&key(t.kind)) {
+            return w.clone();
+        }
+        self.whiten_raw(&self.raw(t))
+    }
+
+    /// The raw (unwhitened) columns of `terms` and the residual's window
+    /// means less their fixed parts.
+    pub fn raw_problem(&self, terms: &[Term]) -> (Vec<Vec<f64>>, Vec<f64>) {
         let mut y = self.r.clone();
         let mut cols = vec![];
         for t in terms {
-            let (c, o) = self.wbasis(t);
+            let raw = self.raw(t);
+            if let Some(o) = raw.offset {
+                for (a, b) in y.iter_mut().zip(o) {
+                    *a -= b;
+                }
+            }
+            cols.extend(raw.cols);
+        }
+        (cols, y)
+    }
+
+    /// The whitened columns of `terms` and the whitened residual less
+    /// their fixed parts.
+    pub fn whitened_problem(&self, terms: &[Term]) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let mut y = self.y.clone();
+        let mut cols: Vec<Vec<f64>> = vec![];
+        for t in terms {
+            let (c, o) = self.whitened(t);
             if let Some(o) = o {
                 for (a, b) in y.iter_mut().zip(o) {
                     *a -= b;
@@ -50,39 +196,62 @@ impl Design<'_> {
             }
             cols.extend(c);
         }
-        if cols.is_empty() {
-            return Some((None, y));
-        }
-        let f = wls(&cols, &y, Some(&self.win.count))?;
-        let resid = f.resid.clone();
-        Some((Some(f), resid))
+        (cols, y)
     }
 
-    /// Weighted sum of squared residual of a joint fit (infinite when
-    /// singular).
+    /// Joint least-squares fit of `terms` on the whitened problem; None
+    /// when their columns are degenerate.
+    pub fn fit(&self, terms: &[Term]) -> Option<Fit> {
+        let (cols, y) = self.whitened_problem(terms);
+        let coef = if cols.is_empty() {
+            vec![]
+        } else {
+            normal_solve(&cols, &y)?
+        };
+        let mut resid = y;
+        for (c, b) in cols.iter().zip(&coef) {
+            for (r, v) in resid.iter_mut().zip(c) {
+                *r -= b * v;
+            }
+        }
+        let sse = resid.iter().map(|v| v * v).sum();
+        Some(Fit { coef, resid, sse })
+    }
+
+    /// Whitened sum of squares of a joint fit (infinite when degenerate).
     pub fn sse(&self, terms: &[Term]) -> f64 {
-        match self.fit(terms) {
-            Some((_, r)) => r.iter().zip(&self.win.count).map(|(v, c)| c * v * v).sum(),
-            None => f64::INFINITY,
-        }
+        self.fit(terms).map_or(f64::INFINITY, |f| f.sse)
     }
 
-    pub fn n(&self) -> f64 {
-        self.win.len() as f64
+    /// The criterion of a fit with `dof` free parameters: BIC of the
+    /// whitened problem, n ln(SSE/n)/phi + dof ln n.
+    pub fn criterion(&self, sse: f64, dof: usize) -> f64 {
+        let n = self.n().max(2.0);
+        n * (sse.max(1e-300) / n).ln() / self.phi.max(1.0) + dof as f64 * n.ln()
+    }
+
+    /// The criterion of the joint fit of `terms`.
+    pub fn criterion_of(&self, terms: &[Term]) -> f64 {
+        let dof = terms.iter().map(|t| t.kind.dof()).sum();
+        self.criterion(self.sse(terms), dof)
+    }
+
+    /// Search grid of a term's non-linear parameter: an effect's, or the
+    /// steps offered.
+    fn grid(&self, t: &Term) -> (Vec<f64>, bool) {
+        match t.kind {
+            Kind::Effect(e) => (e.search_grid(self.inp), e.search_log()),
+            _ => (vec![], false),
+        }
     }
 
     /// Best non-linear parameter of `terms[j]` with the others held: grid
     /// then golden section (in ln x for positive, decade-spanning ones).
     pub fn optimize(&self, terms: &mut [Term], j: usize) {
-        let e = terms[j].effect;
-        if e.nonlinear_param().is_none() {
-            return;
-        }
-        let grid = e.search_grid(self.inp);
+        let (grid, log) = self.grid(&terms[j]);
         if grid.is_empty() {
             return;
         }
-        let log = e.search_log();
         let mut ts = terms.to_vec();
         let cost = |v: f64| {
             ts[j].x = if log { v.exp() } else { v };
@@ -99,58 +268,102 @@ impl Design<'_> {
 
     /// Local re-fit of `terms[j]`'s non-linear parameter around its value.
     pub fn refine(&self, terms: &mut [Term], j: usize) {
-        let e = terms[j].effect;
-        if e.nonlinear_param().is_none() {
+        let (grid, log) = self.grid(&terms[j]);
+        if grid.is_empty() {
             return;
         }
-        let log = e.search_log();
-        let x0 = if log { terms[j].x.ln() } else { terms[j].x };
-        let half = if log { 0.3 } else { 1.0 };
+        let (lo, hi) = grid
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
+                (a.0.min(x), a.1.max(x))
+            });
+        let x0 = terms[j].x.clamp(lo, hi);
+        let (a, b) = if log {
+            ((x0.ln() - 0.3).max(lo.ln()), (x0.ln() + 0.3).min(hi.ln()))
+        } else {
+            ((x0 - 1.0).max(lo), (x0 + 1.0).min(hi))
+        };
         let mut ts = terms.to_vec();
         let (v, _) = golden(
             |v: f64| {
                 ts[j].x = if log { v.exp() } else { v };
                 self.sse(&ts)
             },
-            x0 - half,
-            x0 + half,
+            a,
+            b,
             25,
         );
         terms[j].x = if log { v.exp() } else { v };
     }
 
-    /// Variance inflation of the windowed residual of `terms` for
-    /// correlated noise, within 1..100: the largest batch-means ratio over
-    /// block lengths of 2, 4, 8 ... windows up to a sixteenth of the record
-    /// (the variance of block means times the block length, over the
-    /// windows' variance: 1 for white noise). Bias instability and random
-    /// walk wander most at the slow effects' hour scales, which a lag-1
-    /// correlation of 1 s windows (or an Allan term fit, where white noise
-    /// dominates every measured tau) does not see; unweighted by it, their
-    /// wander passes for a thermal term or a bias.
-    pub fn inflation(&self, terms: &[Term]) -> f64 {
-        let Some((_, r)) = self.fit(terms) else {
-            return 1.0;
-        };
-        let n = r.len();
-        let var = |x: &[f64]| {
-            let m = x.iter().sum::<f64>() / x.len() as f64;
-            x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1).max(1) as f64
-        };
-        let v1 = var(&r);
-        if v1.is_nan() || v1 <= 0.0 {
-            return 1.0;
+    /// A term's part at coefficients `coef` (its own columns'), whitened.
+    pub fn whitened_part(&self, t: &Term, coef: &[f64]) -> Vec<f64> {
+        let raw = self.raw(t);
+        let mut p = raw.offset.unwrap_or_else(|| vec![0.0; self.win.len()]);
+        for (c, b) in raw.cols.iter().zip(coef) {
+            for (a, v) in p.iter_mut().zip(c) {
+                *a += b * v;
+            }
         }
-        let mut phi: f64 = 1.0;
-        let mut l = 2;
-        while l * 16 <= n {
-            let means: Vec<f64> = r
-                .chunks_exact(l)
-                .map(|c| c.iter().sum::<f64>() / l as f64)
-                .collect();
-            phi = phi.max(var(&means) * l as f64 / v1);
-            l *= 2;
-        }
-        phi.clamp(1.0, 100.0)
+        self.wh.whiten(&p)
     }
+
+    /// Each term's part of a fit, in window means of deg/s (unwhitened):
+    /// its columns times its coefficients plus its fixed part.
+    pub fn parts(&self, terms: &[Term], coef: &[f64]) -> Vec<Vec<f64>> {
+        let mut col = 0;
+        terms
+            .iter()
+            .map(|t| {
+                let raw = self.raw(t);
+                let mut p = raw.offset.unwrap_or_else(|| vec![0.0; self.win.len()]);
+                for c in &raw.cols {
+                    let b = coef.get(col).copied().unwrap_or(0.0);
+                    for (a, v) in p.iter_mut().zip(c) {
+                        *a += b * v;
+                    }
+                    col += 1;
+                }
+                p
+            })
+            .collect()
+    }
+}
+
+/// Variance inflation of a whitened residual `r` (windows left out are
+/// zeros, dropped) for the correlation its noise model did not capture:
+/// the largest batch-means ratio over blocks of 8, 16, 32 ... windows up
+/// to a sixteenth of the record (the variance of block means times the
+/// block length, over the residual's variance: 1 for white innovations),
+/// within 1 .. 100.
+pub fn inflation(r: &[f64], keep: &[bool]) -> f64 {
+    let x: Vec<f64> = r
+        .iter()
+        .zip(keep)
+        .filter(|(_, k)| **k)
+        .map(|(v, _)| *v)
+        .collect();
+    let n = x.len();
+    let var = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        v.iter().map(|a| (a - m).powi(2)).sum::<f64>() / (v.len() - 1).max(1) as f64
+    };
+    if n < 32 {
+        return 1.0;
+    }
+    let v1 = var(&x);
+    if !(v1 > 0.0) {
+        return 1.0;
+    }
+    let mut phi: f64 = 1.0;
+    let mut l = 8;
+    while l * 16 <= n {
+        let means: Vec<f64> = x
+            .chunks_exact(l)
+            .map(|c| c.iter().sum::<f64>() / l as f64)
+            .collect();
+        phi = phi.max(var(&means) * l as f64 / v1);
+        l *= 2;
+    }
+    phi.clamp(1.0, 100.0)
 }

@@ -1,81 +1,241 @@
-//! The parameters of the effects found, with their 95 % intervals, and
-//! each one's share of the residual variance.
+//! The parameters of the effects found and carried, from the final joint
+//! fit (the nuisance terms in it, so that what the library does not
+//! explain drags no effect), with 95 % intervals that account for the
+//! residual's coloured noise: generalised least squares on the whitened
+//! problem (design.rs), its variance scaled by the fit's own whitened
+//! residual and by the correlation that residual still holds (design.rs's
+//! batch-means inflation). The covariance is the Gauss-Newton one of all
+//! parameters at once (the non-linear ones' derivative columns beside the
+//! linear columns), so a linear parameter's interval includes what the
+//! uncertain knee, time constant or lock-in rate it goes with adds; a
+//! non-linear parameter's interval is the wider of that and its profile.
 
-use super::design::{Design, Term};
-use super::select::Selection;
+use super::design::{inflation, Design};
+use super::select::{columns, params_of};
+use super::terms::{Kind, Term};
 use crate::model::effects::Effect;
-use crate::numerics::search::{profile_interval, CHI2_1_95};
+use crate::numerics::lsq::wls;
+use crate::numerics::search::CHI2_1_95;
 
-/// A found effect's parameters with 95 % intervals.
+/// An effect's parameters with 95 % intervals: (name, value, lo, hi).
 #[derive(Clone, Debug)]
 pub struct Estimate {
     pub effect: Effect,
     pub params: Vec<(&'static str, f64, f64, f64)>,
+    /// The criterion's change were it taken out of the final fit
+    /// (negative: it pays).
     pub delta_bic: f64,
+    /// Share of the residual's variance (1 s means) it explains.
     pub explained_share: f64,
 }
 
-/// Parameters of the chosen effects from the final joint fit (nuisance
-/// included), their intervals (linear: least squares with the inflated
-/// residual variance; non-linear: profile likelihood) and each effect's
-/// share of the residual variance (the rise of the weighted residual sum
-/// without it, over the sum before any effect).
-pub fn estimates(d: &Design, sel: &Selection) -> Vec<Estimate> {
-    let terms: Vec<Term> = sel.terms();
-    let Some((fit, r)) = d.fit(&terms) else {
-        return vec![];
+/// The final joint fit: every term's estimate (None for terms without a
+/// name: shapes, steps), its part of the residual in window means (deg/s),
+/// and the variance scale of the whitened residual.
+pub struct Final {
+    pub estimates: Vec<Option<Estimate>>,
+    pub parts: Vec<Vec<f64>>,
+    pub scale: f64,
+}
+
+/// Estimates of every term of `terms` (the constant first) from their joint
+/// fit.
+pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
+    let f = d.fit(terms)?;
+    let n = d.n();
+    let p: usize = terms.iter().map(|t| t.kind.dof()).sum();
+    let phi = d.phi.max(inflation(&f.resid, &d.wh.keep));
+    let scale = f.sse / (n - p as f64).max(1.0) * phi;
+    let cov = jacobian_cov(d, terms, &f.coef);
+    let parts = d.parts(terms, &f.coef);
+    let w = &d.win.count;
+    let ss = |x: &[f64]| -> f64 {
+        x.iter()
+            .zip(w)
+            .zip(&d.wh.keep)
+            .filter(|(_, k)| **k)
+            .map(|((v, c), _)| c * v * v)
+            .sum()
     };
-    let sse: f64 = r.iter().zip(&d.win.count).map(|(v, c)| c * v * v).sum();
-    let sse0: f64 = d.r.iter().zip(&d.win.count).map(|(v, c)| c * v * v).sum();
-    let p: usize = terms
-        .iter()
-        .map(|t| t.effect.linear_params().len() + usize::from(t.effect.nonlinear_param().is_some()))
-        .sum();
-    let var = sse / (d.n() - p as f64).max(1.0);
-    let v = var * sel.inflation;
+    let sum_parts: Vec<f64> = (0..d.r.len())
+        .map(|k| parts.iter().map(|p| p[k]).sum::<f64>())
+        .collect();
+    let r_full: Vec<f64> = d.r.iter().zip(&sum_parts).map(|(a, b)| a - b).collect();
+    let (ss0, ss_full) = (ss(&d.r), ss(&r_full));
+    let c_full = d.criterion(f.sse, p);
     let mut out = vec![];
     let mut col = 0;
-    for (j, step) in sel.chosen.iter().enumerate() {
-        let e = step.term.effect;
+    for (j, t) in terms.iter().enumerate() {
+        let ncol = columns(t.kind);
+        let effect = match t.kind {
+            Kind::Constant => Some(Effect::Bias),
+            Kind::Effect(e) => Some(e),
+            _ => None,
+        };
+        let Some(effect) = effect else {
+            out.push(None);
+            col += ncol;
+            continue;
+        };
+        let values = params_of(terms, &f, j);
         let mut params = vec![];
-        for name in e.linear_params() {
-            let (c, se) = match &fit {
-                Some(f) => (f.coef[col], f.se(col, v)),
-                None => (0.0, 0.0),
-            };
-            params.push((*name, c, c - 1.96 * se, c + 1.96 * se));
-            col += 1;
-        }
-        if let Some(name) = e.nonlinear_param() {
-            let log = e.search_log();
-            let x = step.term.x;
-            let prof = |u: f64| {
-                let mut ts = terms.clone();
-                ts[j].x = if log { u.exp() } else { u };
-                d.sse(&ts)
-            };
-            let (u0, step_u, bounds) = if log {
-                (x.ln(), 0.005, (x.ln() - 5.0, x.ln() + 5.0))
+        for (i, (name, v)) in values.iter().enumerate() {
+            if i < ncol {
+                let se = cov
+                    .as_ref()
+                    .map_or(f64::NAN, |c| (c.0[(col + i, col + i)] * scale).sqrt());
+                params.push((*name, *v, v - 1.96 * se, v + 1.96 * se));
             } else {
-                (x, 0.02, (x - 30.0, x + 30.0))
-            };
-            let (lo, hi) = profile_interval(prof, u0, sse, CHI2_1_95 * v, step_u, bounds);
-            let (lo, hi) = if log { (lo.exp(), hi.exp()) } else { (lo, hi) };
-            params.push((name, x, lo, hi));
+                let (lo, hi) = profile(d, terms, j, f.sse, scale);
+                // The Gauss-Newton interval, in the search's variable.
+                let wald = cov.as_ref().and_then(|c| {
+                    let k = c.1.iter().position(|&x| x == j)?;
+                    let se = (c.0[(c.2 + k, c.2 + k)] * scale).sqrt();
+                    let log = t.kind.effect().is_some_and(|e| e.search_log());
+                    Some(if log {
+                        ((v.ln() - 1.96 * se).exp(), (v.ln() + 1.96 * se).exp())
+                    } else {
+                        (v - 1.96 * se, v + 1.96 * se)
+                    })
+                });
+                let (lo, hi) = match wald {
+                    Some((a, b)) if a.is_finite() && b.is_finite() => (lo.min(a), hi.max(b)),
+                    _ => (lo, hi),
+                };
+                params.push((*name, *v, lo, hi));
+            }
         }
-        let without: Vec<Term> = terms
+        col += ncol;
+        let rest: Vec<Term> = terms
             .iter()
             .enumerate()
             .filter(|(i, _)| *i != j)
             .map(|(_, t)| *t)
             .collect();
-        let share = ((d.sse(&without) - sse) / sse0).clamp(0.0, 1.0);
-        out.push(Estimate {
-            effect: e,
+        let delta_bic = c_full - d.criterion_of(&rest);
+        let with_back: Vec<f64> = r_full.iter().zip(&parts[j]).map(|(a, b)| a + b).collect();
+        let share = if ss0 > 0.0 {
+            ((ss(&with_back) - ss_full) / ss0).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        out.push(Some(Estimate {
+            effect,
             params,
-            delta_bic: step.delta_bic,
+            delta_bic,
             explained_share: share,
-        });
+        }));
     }
-    out
+    Some(Final {
+        estimates: out,
+        parts,
+        scale,
+    })
+}
+
+/// The unscaled covariance of every linear coefficient (first, in the
+/// fit's column order) and of the non-linear parameters (after, for the
+/// terms listed, in ln x where the search is logarithmic): (cov, terms with
+/// a non-linear parameter, index of the first of them).
+fn jacobian_cov(
+    d: &Design,
+    terms: &[Term],
+    coef: &[f64],
+) -> Option<(nalgebra::DMatrix<f64>, Vec<usize>, usize)> {
+    let (mut cols, y) = d.whitened_problem(terms);
+    let nlin = cols.len();
+    let mut which = vec![];
+    let mut col = 0;
+    for (j, t) in terms.iter().enumerate() {
+        let nc = columns(t.kind);
+        if let Kind::Effect(e) = t.kind {
+            if e.nonlinear_param().is_some() {
+                let own = &coef[col.min(coef.len())..(col + nc).min(coef.len())];
+                let log = e.search_log();
+                let at: fn(f64, f64) -> f64 = if log {
+                    |x, s| x * s.exp()
+                } else {
+                    |x, s| x + s
+                };
+                let h = if log { 1e-4 } else { 1e-3 * t.x.abs().max(1.0) };
+                let mut tp = *t;
+                tp.x = at(t.x, h);
+                let up = d.whitened_part(&tp, own);
+                tp.x = at(t.x, -h);
+                let dn = d.whitened_part(&tp, own);
+                let g: Vec<f64> = up
+                    .iter()
+                    .zip(&dn)
+                    .map(|(a, b)| (a - b) / (2.0 * h))
+                    .collect();
+                if g.iter().any(|v| *v != 0.0) {
+                    cols.push(g);
+                    which.push(j);
+                }
+            }
+        }
+        col += nc;
+    }
+    if cols.is_empty() {
+        return None;
+    }
+    let ls = wls(&cols, &y, None)?;
+    Some((ls.cov_unscaled, which, nlin))
+}
+
+/// Profile-likelihood 95 % interval of `terms[j]`'s non-linear parameter:
+/// scanned each way from the estimate until the whitened sum of squares
+/// rises by chi-square(1, 95 %) times the variance scale, the crossing
+/// interpolated in the square root of the rise (linear for a quadratic
+/// profile); the step halved until the first one stays under it.
+fn profile(d: &Design, terms: &[Term], j: usize, sse: f64, scale: f64) -> (f64, f64) {
+    let Kind::Effect(e) = terms[j].kind else {
+        return (f64::NAN, f64::NAN);
+    };
+    let log = e.search_log();
+    let x = terms[j].x;
+    let prof = |u: f64| {
+        let mut ts = terms.to_vec();
+        ts[j].x = if log { u.exp() } else { u };
+        d.sse(&ts) - sse
+    };
+    let thr = CHI2_1_95 * scale;
+    let (u0, bound) = if log { (x.ln(), 5.0) } else { (x, 30.0) };
+    let side = |dir: f64| -> f64 {
+        let mut step = if log { 0.02 } else { 0.1 };
+        for _ in 0..40 {
+            if prof(u0 + dir * step) < thr {
+                break;
+            }
+            step *= 0.5;
+        }
+        let (mut u, mut prev) = (u0, 0.0f64);
+        let mut k = 0;
+        while (u - u0).abs() < bound && k < 400 {
+            let nu = u + dir * step;
+            let dv = prof(nu);
+            if dv >= thr {
+                let (a, b, c) = (prev.max(0.0).sqrt(), dv.sqrt(), thr.sqrt());
+                let f = if b > a {
+                    ((c - a) / (b - a)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                return u + dir * step * f;
+            }
+            u = nu;
+            prev = dv;
+            k += 1;
+            if k % 20 == 0 {
+                step *= 2.0;
+            }
+        }
+        u0 + dir * bound
+    };
+    let (lo, hi) = (side(-1.0), side(1.0));
+    if log {
+        (lo.exp(), hi.exp())
+    } else {
+        (lo, hi)
+    }
 }

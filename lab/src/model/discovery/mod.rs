@@ -1,21 +1,33 @@
 //! Discovery (docs/discovery.md): where a model and the measured data
 //! disagree, the named effect that is missing, the model with it added,
-//! and the gap shrinking. The run flows down, once:
+//! and the gap shrinking; and, said plainly, what no effect of the library
+//! explains. The run flows down, once:
 //!
 //! 1. The model (gyro_model.rs) is evaluated on the run's inputs; the
-//!    residual is measured minus model.
-//! 2. The noise floor comes from the residual itself (noise_floor.rs), and
-//!    the stretches where the residual, smoothed over 60 s, stands out.
-//! 3. Every applicable effect of the library (effects.rs) is a candidate;
-//!    select.rs chooses among them by BIC on the windowed problem of
-//!    design.rs, names ambiguous groups; estimates.rs gives the
-//!    parameters with intervals.
-//! 4. The model with the found effects added, and its residual.
+//!    residual is measured minus model, averaged over 1 s windows.
+//! 2. A first selection (select.rs) with white noise; spikes and steps in
+//!    what it leaves (transients.rs); the residual's noise from the Allan
+//!    analysis of what it leaves (noise_model.rs); then the selection
+//!    again on the problem whitened by that noise (design.rs), until the
+//!    names no longer change (at most three passes).
+//! 3. Every fit carries a constant (constant.rs says whether it is a
+//!    bias); the library's effects (effects.rs) and shapes it has no name
+//!    for (terms.rs) compete; implausible fits (ranges.rs) and ambiguous
+//!    groups are not named. estimates.rs gives the parameters with
+//!    intervals; unexplained.rs what is left.
+//! 4. The model with the named and carried effects added, checked never to
+//!    explain less than the one it started from.
 
+pub mod constant;
 pub mod design;
 pub mod estimates;
 pub mod noise_floor;
+pub mod noise_model;
+pub mod normal;
 pub mod select;
+pub mod terms;
+pub mod transients;
+pub mod unexplained;
 pub mod windows;
 
 use crate::data::run_file::Column;
@@ -23,18 +35,26 @@ use crate::model::effects::Effect;
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::{Model, ModelEffect};
 use crate::model::inputs::Inputs;
+use crate::model::ranges::Extent;
 use crate::noise::analysis::Allan;
-use design::{Design, Term};
-use estimates::{estimates, Estimate};
+use constant::Role;
+use design::{inflation, Design};
+use estimates::{estimate, Estimate};
 use noise_floor::{allan_of, disagreements, gap, noise_floor, Disagreement};
-use select::{select, Selection};
+use noise_model::{NoiseModel, Whitener};
+use select::{select, Ambiguous, Implausible, Selection};
 use std::collections::BTreeMap;
+use terms::{rotating, Kind, Term};
+use transients::Transients;
+use unexplained::{assess, Sources, Unexplained};
 use windows::Windows;
 
 /// The gap's averaging, s.
 pub const WINDOW_S: f64 = 1.0;
 /// Smoothing of the disagreement search, s.
 pub const SMOOTH_S: f64 = 60.0;
+/// Most passes of the selection.
+pub const MAX_PASSES: usize = 4;
 
 /// A run's inputs and measured rate (deg/s).
 pub struct Run {
@@ -42,19 +62,44 @@ pub struct Run {
     pub rate: Vec<f64>,
 }
 
+/// An effect of the library the run cannot show, and why.
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    pub effect: Effect,
+    /// The columns it needs that the run lacks (empty: another reason).
+    pub missing: &'static [Column],
+    pub reason: String,
+}
+
+/// An effect carried in the model without being named, and why.
+#[derive(Clone, Debug)]
+pub struct Carried {
+    pub estimate: Estimate,
+    pub why: String,
+}
+
 pub struct Discovery {
     pub gyro: GyroKind,
+    /// Named effects, in the order they came in (a bias first).
     pub found: Vec<Estimate>,
-    pub selection: Selection,
-    /// Effects of the library the run lacks the inputs for, with the
-    /// columns missing.
-    pub skipped: Vec<(Effect, &'static [Column])>,
+    pub carried: Vec<Carried>,
+    pub ambiguous: Vec<Ambiguous>,
+    pub implausible: Vec<Implausible>,
+    pub unexplained: Option<Unexplained>,
+    /// Effects the backward steps removed after they came in.
+    pub dropped: Vec<String>,
+    pub skipped: Vec<Skipped>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
     pub windows: Windows,
     pub gap_before_dph: f64,
     pub gap_after_dph: f64,
     pub noise_floor_dph: f64,
+    pub noise: NoiseModel,
+    pub passes: usize,
+    /// Set when the joint fit's parameters would have widened the gap and
+    /// the model written was re-fitted without the unexplained terms.
+    pub fallback: Option<String>,
     pub disagreements: Vec<Disagreement>,
     pub model_after: Model,
     pub allan_before: Option<Allan>,
@@ -67,72 +112,315 @@ fn residual(model: &Model, run: &Run) -> Vec<f64> {
     run.rate.iter().zip(&sim).map(|(y, s)| y - s).collect()
 }
 
-/// The library's effects of this gyro the run can show, and those it
-/// lacks the inputs for.
-type Candidates = (Vec<Effect>, Vec<(Effect, &'static [Column])>);
-
-fn candidates(gyro: GyroKind, inp: &Inputs) -> Candidates {
-    let of_gyro = || Effect::ALL.into_iter().filter(move |e| e.applies_to(gyro));
-    (
-        of_gyro().filter(|e| e.available(inp)).collect(),
-        of_gyro()
-            .filter(|e| !e.available(inp))
-            .map(|e| (e, e.needs()))
-            .collect(),
-    )
-}
-
-/// Two passes: the residual correlation of the first selection sets the
-/// variance inflation of the second.
-fn select_twice(design: &Design, candidates: &[Effect]) -> Selection {
-    let first = select(design, candidates, 1.0);
-    let terms: Vec<Term> = first.terms();
-    let phi = design.inflation(&terms);
-    select(design, candidates, phi)
-}
-
-/// `model` with the effects found added.
-fn with_found(model: &Model, found: &[Estimate]) -> Model {
-    let mut after = model.clone();
-    for e in found {
-        let params: BTreeMap<String, f64> =
-            e.params.iter().map(|p| (p.0.to_owned(), p.1)).collect();
-        after.effects.push(ModelEffect {
-            effect: e.effect,
-            params,
-        });
+/// The library's effects of this gyro the run can show (the bias aside:
+/// every fit carries its constant), and those it cannot.
+fn candidates(gyro: GyroKind, inp: &Inputs) -> (Vec<Effect>, Vec<Skipped>) {
+    let turns = rotating(inp);
+    let mut ok = vec![];
+    let mut skipped = vec![];
+    for e in Effect::ALL.into_iter().filter(|e| e.applies_to(gyro)) {
+        if !e.available(inp) {
+            skipped.push(Skipped {
+                effect: e,
+                missing: e.needs(),
+                reason: "the run lacks its inputs".into(),
+            });
+        } else if e.needs_rotation() && !turns {
+            skipped.push(Skipped {
+                effect: e,
+                missing: &[],
+                reason: format!(
+                    "the run does not turn (no rate of {} deg/s): a scale factor cannot show at rest",
+                    terms::ROTATING_DPS
+                ),
+            });
+        } else if e != Effect::Bias {
+            ok.push(e);
+        }
     }
-    after
+    (ok, skipped)
+}
+
+/// What a run covers.
+fn extent(inp: &Inputs) -> Extent {
+    let t0 = inp.t.first().copied().unwrap_or(0.0);
+    let t1 = inp.t.last().copied().unwrap_or(0.0);
+    let temp_c = inp.temp.as_ref().map(|v| {
+        v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
+            (a.0.min(x), a.1.max(x))
+        })
+    });
+    Extent {
+        record_s: (t1 - t0).max(0.0),
+        temp_c,
+    }
+}
+
+/// Window means of `r` less every part of `terms` in `d`'s final fit.
+fn left(d: &Design, terms: &[Term]) -> Vec<f64> {
+    let Some(f) = d.fit(terms) else {
+        return d.r.clone();
+    };
+    let parts = d.parts(terms, &f.coef);
+    (0..d.r.len())
+        .map(|k| d.r[k] - parts.iter().map(|p| p[k]).sum::<f64>())
+        .collect()
+}
+
+/// The passes: white noise first, then the noise of what each leaves.
+fn passes<'a>(
+    inp: &'a Inputs,
+    win: &'a Windows,
+    rw: &[f64],
+    cands: &[Effect],
+) -> (Design<'a>, Selection, NoiseModel, Transients, usize) {
+    let n = win.len();
+    let x = extent(inp);
+    let all = vec![true; n];
+    let white = NoiseModel::white_of(rw, &all);
+    let d1 = Design::new(
+        inp,
+        win,
+        x,
+        rw.to_vec(),
+        Whitener::new(&white, win, &all),
+        vec![],
+    );
+    let sel1 = select(&d1, cands);
+    let e1 = left(&d1, &sel1.terms());
+    let tr = transients::find(win, &e1);
+    let keep = tr.keep(n);
+    let tau0 = if n > 1 {
+        (win.t[n - 1] - win.t[0]) / (n - 1) as f64
+    } else {
+        WINDOW_S
+    };
+    let noise_a = NoiseModel::from_residual(&e1, &keep, tau0);
+    let design = |noise: &NoiseModel| {
+        Design::new(
+            inp,
+            win,
+            x,
+            rw.to_vec(),
+            Whitener::new(noise, win, &keep),
+            tr.steps.clone(),
+        )
+    };
+    let d2 = design(&noise_a);
+    let sel2 = select(&d2, cands);
+    // The noise's slow levels by maximum likelihood given what the second
+    // pass selected, then the selection again on that noise (weighing the
+    // criterion by the correlation its whitened residual still holds);
+    // once more if the noise and the names still moved.
+    let ml = |d: &Design, sel: &Selection, start: &NoiseModel| {
+        let (cols, y) = d.raw_problem(&sel.terms());
+        noise_model::refine(start, win, &keep, &y, &cols)
+    };
+    let mut noise = ml(&d2, &sel2, &noise_a);
+    let mut names = sel2.named_effects();
+    let mut prev = sel2.terms();
+    let mut pass = 2;
+    loop {
+        pass += 1;
+        let mut d = design(&noise);
+        d.phi = d.fit(&prev).map_or(1.0, |f| inflation(&f.resid, &keep));
+        let sel = select(&d, cands);
+        let now = sel.named_effects();
+        if now == names || pass >= MAX_PASSES {
+            return (d, sel, noise, tr, pass);
+        }
+        names = now;
+        prev = sel.terms();
+        noise = ml(&d, &sel, &noise);
+    }
+}
+
+/// A model effect from an estimate's values.
+fn model_effect(e: &Estimate) -> ModelEffect {
+    ModelEffect {
+        effect: e.effect,
+        params: e
+            .params
+            .iter()
+            .map(|p| (p.0.to_owned(), p.1))
+            .collect::<BTreeMap<String, f64>>(),
+    }
+}
+
+/// `model` with `add` appended.
+fn with(model: &Model, add: &[&Estimate]) -> Model {
+    let mut m = model.clone();
+    m.effects.extend(add.iter().map(|e| model_effect(e)));
+    m
+}
+
+/// Least squares of the window means on the written terms alone (no
+/// whitening, no nuisance): never worse than no term, by construction.
+fn plain_refit(d: &Design, written: &[(Term, Estimate)]) -> Vec<Estimate> {
+    let mut y = d.r.clone();
+    let mut cols = vec![];
+    for (t, _) in written {
+        let raw = d.raw(t);
+        if let Some(o) = raw.offset {
+            for (a, b) in y.iter_mut().zip(o) {
+                *a -= b;
+            }
+        }
+        cols.extend(raw.cols);
+    }
+    let coef = if cols.is_empty() {
+        Some(vec![])
+    } else {
+        crate::numerics::lsq::wls(&cols, &y, None).map(|f| f.coef)
+    };
+    let Some(coef) = coef else {
+        return vec![];
+    };
+    let mut col = 0;
+    written
+        .iter()
+        .map(|(t, e)| {
+            let mut e = e.clone();
+            for p in e.params.iter_mut() {
+                if t.kind == Kind::Effect(Effect::LockIn) || Some(p.0) == e.effect.nonlinear_param()
+                {
+                    continue;
+                }
+                p.1 = coef.get(col).copied().unwrap_or(p.1);
+                col += 1;
+            }
+            e
+        })
+        .collect()
 }
 
 /// What `model` misses of `run`: the effects found, the model with them
-/// added, and the residual before and after.
+/// added, the residual before and after, and what stays unexplained.
 pub fn discover(model: &Model, run: &Run) -> Discovery {
     let inp = &run.inputs;
     let r = residual(model, run);
     let win = Windows::new(&inp.t, WINDOW_S);
+    let rw = win.mean(&r);
     let allan_before = allan_of(&inp.t, &r);
     let floor = noise_floor(&win, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
-    let (candidates, skipped) = candidates(model.gyro, inp);
-    let design = Design {
-        inp,
-        win: &win,
-        r: win.mean(&r),
+    let (cands, skipped) = candidates(model.gyro, inp);
+    let (d, sel, noise, tr, passes) = passes(inp, &win, &rw, &cands);
+    let (role, amb_const, _) = constant::role(&d, &sel, &cands);
+    let terms = sel.terms();
+    let fin = estimate(&d, &terms);
+    let est = |j: usize| -> Option<Estimate> {
+        fin.as_ref()
+            .and_then(|f| f.estimates.get(j).cloned().flatten())
     };
-    let selection = select_twice(&design, &candidates);
-    let found = estimates(&design, &selection);
-    let model_after = with_found(model, &found);
-    let r_after = residual(&model_after, run);
+    let nn = sel.named.len();
+    let nc = sel.carried.len();
+    // The model written: the constant (unless nothing needs it), the named
+    // effects, the ambiguous groups' representatives.
+    let mut written: Vec<(Term, Estimate, Option<String>)> = vec![];
+    if role != Role::Unneeded {
+        if let Some(e) = est(0) {
+            let why = match role {
+                Role::Named => None,
+                Role::Ambiguous => Some("the constant, for the ambiguous group it heads".into()),
+                _ => Some(
+                    "the constant the other terms are fitted with (no bias of its own: removing it, or letting a warm-up settle to nothing, costs less than the threshold)"
+                        .into(),
+                ),
+            };
+            written.push((terms[0], e, why));
+        }
+    }
+    for j in 1..=nn {
+        if let Some(e) = est(j) {
+            written.push((terms[j], e, None));
+        }
+    }
+    for j in nn + 1..=nn + nc {
+        if let Some(e) = est(j) {
+            written.push((
+                terms[j],
+                e,
+                Some("the simplest of an ambiguous group, carried for it".into()),
+            ));
+        }
+    }
+    let gap_before = gap(&win, &r);
+    let build = |w: &[(Term, Estimate, Option<String>)]| {
+        let m = with(model, &w.iter().map(|x| &x.1).collect::<Vec<_>>());
+        let ra = residual(&m, run);
+        let g = gap(&win, &ra);
+        (m, ra, g)
+    };
+    let (mut model_after, mut r_after, mut gap_after) = build(&written);
+    let mut fallback = None;
+    if gap_after > gap_before {
+        let pairs: Vec<(Term, Estimate)> = written.iter().map(|x| (x.0, x.1.clone())).collect();
+        let refit = plain_refit(&d, &pairs);
+        if refit.len() == written.len() {
+            for (w, e) in written.iter_mut().zip(refit) {
+                w.1 = e;
+            }
+        } else {
+            written.clear();
+        }
+        (model_after, r_after, gap_after) = build(&written);
+        if gap_after > gap_before {
+            written.clear();
+            (model_after, r_after, gap_after) = build(&written);
+        }
+        fallback = Some(format!(
+            "the joint fit with the unexplained terms would have widened the gap ({gap_before:.4} deg/h before); the model written was re-fitted on its own effects"
+        ));
+    }
+    let mut found = vec![];
+    let mut carried = vec![];
+    for (_, e, why) in written {
+        match why {
+            None => found.push(e),
+            Some(w) => carried.push(Carried {
+                estimate: e,
+                why: w,
+            }),
+        }
+    }
+    let mut ambiguous = sel.ambiguous.clone();
+    ambiguous.extend(amb_const);
+    let whitened = d.fit(&terms).map(|f| f.resid).unwrap_or_default();
+    let after_w = win.mean(&r_after);
+    let parts: Vec<(&[f64], String)> = match &fin {
+        Some(f) => (nn + nc + 1..terms.len())
+            .map(|j| (f.parts[j].as_slice(), terms[j].kind.describe()))
+            .collect(),
+        None => vec![],
+    };
+    let unexplained = assess(
+        &d,
+        &noise,
+        &Sources {
+            parts,
+            spikes: &tr.spikes,
+            whitened: &whitened,
+            scale: fin.as_ref().map_or(1.0, |f| f.scale),
+            after: &after_w,
+        },
+    );
     let allan_after = allan_of(&inp.t, &r_after);
     Discovery {
         gyro: model.gyro,
         found,
-        selection,
+        carried,
+        ambiguous,
+        implausible: sel.implausible.clone(),
+        unexplained,
+        dropped: sel.dropped.iter().map(|k| k.describe()).collect(),
         skipped,
-        gap_before_dph: gap(&win, &r),
-        gap_after_dph: gap(&win, &r_after),
+        gap_before_dph: gap_before,
+        gap_after_dph: gap_after,
         noise_floor_dph: floor,
+        noise,
+        passes,
+        fallback,
         disagreements,
         residual_before: r,
         residual_after: r_after,

@@ -1,41 +1,47 @@
-//! Forward selection of named effects (docs/discovery.md).
+//! Stepwise selection of named effects (docs/discovery.md).
 //!
-//! The residual (measured minus model) and every effect's regressors are
-//! averaged over the same windows (1 s: the gap's averaging), so the fit is
-//! of what the gap measures and the noise of a window mean is close to
-//! white. At each step every candidate effect is fitted jointly with those
-//! already chosen (its non-linear parameter by search); the one that lowers
-//! BIC most is added if it lowers it by more than [`BIC_THRESHOLD`], then
-//! the non-linear parameters of all chosen effects are re-fitted. A lag-1
-//! correlation of the residual inflates the noise variance (and divides the
-//! likelihood gain) by (1 + rho)/(1 - rho).
+//! Every fit carries a constant. At each step every open candidate (the
+//! library's effects, and the shapes and steps the library has no name
+//! for) is fitted jointly with the terms already in (its non-linear
+//! parameter by search); the one that lowers the criterion most comes in
+//! if it lowers it by more than [`THRESHOLD`]:
 //!
-//! Collinearity: when another candidate explains nearly the same (its BIC
-//! gain within [`AMBIGUITY_MARGIN`] of the best's, and what it explains
-//! correlated with what the best explains at |r| >= [`AMBIGUITY_CORR`]) the
-//! run cannot tell them apart: both are reported as ambiguous, neither is
-//! named; the best stands in the fit as an unnamed nuisance so that other
-//! effects are judged on the rest.
+//! - an effect whose fitted parameters leave their physical range
+//!   (ranges.rs) is not named: it is an implausible fit, kept as a term
+//!   no name explains;
+//! - an effect the run cannot tell from others (their criterion within
+//!   [`AMBIGUITY_MARGIN`], what they explain correlated at |r| >=
+//!   [`AMBIGUITY_CORR`], their parameters plausible) is not named either:
+//!   the group is reported and its simplest member carried in the model;
+//! - a shape or step comes in as what the library does not explain,
+//!   unless an effect explains the same as well (then the effect).
+//!
+//! After each addition every non-linear parameter is re-fitted, and every
+//! term whose removal costs less than [`THRESHOLD`] is dropped, the
+//! cheapest first (backward steps), never to return.
 
-use super::design::{Design, Term};
+use super::design::{Design, Fit};
+use super::terms::{Kind, Shape, Term};
+use super::transients::{cusum_peaks, step_peaks, white_sigma, MAX_STEPS};
 use crate::model::effects::Effect;
+use crate::model::ranges;
 
-/// BIC decrease an effect must bring to be named ("very strong" evidence).
-pub const BIC_THRESHOLD: f64 = 10.0;
-/// Ambiguity: BIC gains within this much of the best (the data prefers
-/// neither strongly) ...
+/// Criterion decrease a term must bring to come in, and to stay ("very
+/// strong" evidence).
+pub const THRESHOLD: f64 = 10.0;
+/// Ambiguity: criteria within this much of the best's ...
 pub const AMBIGUITY_MARGIN: f64 = 10.0;
 /// ... and explained parts correlated this much.
 pub const AMBIGUITY_CORR: f64 = 0.9;
 
-/// A step of the selection.
+/// An effect named, with the criterion's change when it came in.
 #[derive(Clone, Debug)]
 pub struct Step {
     pub term: Term,
     pub delta_bic: f64,
 }
 
-/// Effects a run cannot tell apart.
+/// Effects a run cannot tell apart, and the one carried for them.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Ambiguous {
     pub effects: Vec<Effect>,
@@ -43,29 +49,49 @@ pub struct Ambiguous {
     pub correlation: Vec<f64>,
     pub delta_bic: Vec<f64>,
     pub suggestion: String,
+    /// The member carried in the model for the group (the simplest).
+    pub carried_as: Effect,
+}
+
+/// A fit of an effect whose parameters leave their physical range.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Implausible {
+    pub effect: Effect,
+    pub parameters: Vec<(String, f64)>,
+    /// The parameters outside, with their range.
+    pub outside: Vec<(String, f64, (f64, f64))>,
 }
 
 pub struct Selection {
-    pub chosen: Vec<Step>,
+    pub named: Vec<Step>,
+    /// Representatives of ambiguous groups (effects, unnamed).
+    pub carried: Vec<Term>,
+    /// What no effect of the library explains: shapes, steps, implausible
+    /// effects.
     pub nuisance: Vec<Term>,
     pub ambiguous: Vec<Ambiguous>,
-    pub inflation: f64,
+    pub implausible: Vec<Implausible>,
+    /// Terms the backward steps removed.
+    pub dropped: Vec<Kind>,
 }
 
-/// Weighted cosine of two explained parts: uncentred, because the fits
-/// have no intercept of their own (a bias is an effect like the others),
-/// so two effects that both explain a constant are the same to this run.
-fn corr(a: &[f64], b: &[f64], w: &[f64]) -> f64 {
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for i in 0..a.len() {
-        sab += w[i] * a[i] * b[i];
-        saa += w[i] * a[i] * a[i];
-        sbb += w[i] * b[i] * b[i];
+impl Selection {
+    /// Every term of the final fit: the constant, the named, the carried,
+    /// the nuisance.
+    pub fn terms(&self) -> Vec<Term> {
+        let mut t = vec![Term::of(Kind::Constant)];
+        t.extend(self.named.iter().map(|s| s.term));
+        t.extend(self.carried.iter().copied());
+        t.extend(self.nuisance.iter().copied());
+        t
     }
-    if saa > 0.0 && sbb > 0.0 {
-        sab / (saa * sbb).sqrt()
-    } else {
-        0.0
+
+    /// The named effects.
+    pub fn named_effects(&self) -> Vec<Effect> {
+        self.named
+            .iter()
+            .filter_map(|s| s.term.kind.effect())
+            .collect()
     }
 }
 
@@ -94,8 +120,13 @@ pub fn separation(a: Effect, b: Effect) -> String {
         "sweep the temperature well beyond the knee on both sides"
     } else if pair(VibrationRectification, Bias) {
         "vary the vibration level (off, then several amplitudes): at one level it is a constant bias"
-    } else if pair(ScaleFactorTemperature, CaseTemperature) || pair(ScaleFactorTemperature, Bias) {
+    } else if pair(ScaleFactorTemperature, CaseTemperature)
+        || pair(ScaleFactorTemperature, Bias)
+        || pair(ScaleFactorTemperature, BiasTemperature)
+    {
         "reverse the table or rest during the temperature sweep: at one rate a scale factor over temperature is a bias over temperature"
+    } else if pair(BiasTemperature, Shupe) || pair(BiasTemperature, Bias) {
+        "hold the temperature at plateaus (steps with soaks) and ramp it at different rates: a bias that follows the temperature stays on a plateau, the Shupe bias goes with the ramp"
     } else if pair(LockIn, ScaleFactorError) {
         "add rates close to the lock-in rate (a few times it) and far above it"
     } else {
@@ -104,163 +135,373 @@ pub fn separation(a: Effect, b: Effect) -> String {
     s.to_owned()
 }
 
-/// The chosen effects, then the nuisance ones: the terms of the fit.
-fn current(chosen: &[Step], nuisance: &[Term]) -> Vec<Term> {
-    chosen
-        .iter()
-        .map(|s| s.term)
-        .chain(nuisance.iter().copied())
-        .collect()
-}
-
-impl Selection {
-    /// Every term in the final fit, chosen first.
-    pub fn terms(&self) -> Vec<Term> {
-        current(&self.chosen, &self.nuisance)
+/// Weighted cosine of two explained parts.
+pub fn corr(a: &[f64], b: &[f64]) -> f64 {
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for i in 0..a.len().min(b.len()) {
+        sab += a[i] * b[i];
+        saa += a[i] * a[i];
+        sbb += b[i] * b[i];
+    }
+    if saa > 0.0 && sbb > 0.0 {
+        sab / (saa * sbb).sqrt()
+    } else {
+        0.0
     }
 }
 
-/// A candidate's best fit added to the current set.
+/// The parameters of `terms[j]` in a joint fit: its linear ones from the
+/// coefficients (in the units their names state), then its non-linear one.
+pub fn params_of(terms: &[Term], fit: &Fit, j: usize) -> Vec<(&'static str, f64)> {
+    let mut col = 0;
+    for t in &terms[..j] {
+        col += columns(t.kind);
+    }
+    match terms[j].kind {
+        Kind::Effect(e) => {
+            let mut p: Vec<(&'static str, f64)> = e
+                .linear_params()
+                .iter()
+                .enumerate()
+                .map(|(i, n)| (*n, fit.coef.get(col + i).copied().unwrap_or(0.0)))
+                .collect();
+            if let Some(n) = e.nonlinear_param() {
+                p.push((n, terms[j].x));
+            }
+            p
+        }
+        Kind::Constant => vec![("bias_dph", fit.coef.get(col).copied().unwrap_or(0.0))],
+        _ => vec![],
+    }
+}
+
+/// Columns a term adds to the fit.
+pub fn columns(k: Kind) -> usize {
+    match k {
+        Kind::Effect(e) => e.linear_params().len(),
+        _ => 1,
+    }
+}
+
+/// A candidate fitted jointly with the current terms.
 #[derive(Clone)]
 struct Trial {
     term: Term,
-    delta_bic: f64,
-    /// What it explains beyond the current set (window means).
+    delta: f64,
+    /// What it explains beyond the current set (whitened).
     explained: Vec<f64>,
+    params: Vec<(&'static str, f64)>,
 }
 
-/// Weighted sum of squares of window means.
-fn weighted_sse(d: &Design, r: &[f64]) -> f64 {
-    r.iter().zip(&d.win.count).map(|(v, c)| c * v * v).sum()
-}
-
-/// Every candidate `open` admits, fitted jointly with the current terms
-/// `base` (their residual `r_cur`, its weighted sum `sse_cur`): its BIC
-/// change with inflation `phi` and what it explains.
-fn trials(
-    d: &Design,
-    candidates: &[Effect],
-    open: impl Fn(Effect) -> bool,
-    base: &[Term],
-    (r_cur, sse_cur): (&[f64], f64),
-    phi: f64,
-) -> Vec<Trial> {
-    let n = d.n();
-    let mut evals = vec![];
-    for &e in candidates {
-        if !open(e) {
-            continue;
+impl Trial {
+    fn plausible(&self, d: &Design) -> bool {
+        match self.term.kind {
+            Kind::Effect(e) => ranges::outside(e, &self.params, &d.extent).is_empty(),
+            _ => true,
         }
+    }
+}
+
+/// Every candidate in `open`, fitted with `base` (criterion `c_cur`, its
+/// whitened residual `r_cur`).
+fn trials(d: &Design, open: &[Term], base: &[Term], r_cur: &[f64], c_cur: f64) -> Vec<Trial> {
+    let mut out = vec![];
+    for cand in open {
         let mut terms = base.to_vec();
-        terms.push(Term { effect: e, x: 0.0 });
+        terms.push(*cand);
         let j = terms.len() - 1;
         d.optimize(&mut terms, j);
-        let Some((_, r)) = d.fit(&terms) else {
+        let Some(f) = d.fit(&terms) else {
             continue;
         };
-        let sse = weighted_sse(d, &r);
-        let k = (e.linear_params().len() + usize::from(e.nonlinear_param().is_some())) as f64;
-        evals.push(Trial {
+        let dof: usize = terms.iter().map(|t| t.kind.dof()).sum();
+        out.push(Trial {
             term: terms[j],
-            delta_bic: n * (sse / sse_cur).ln() / phi + k * n.ln(),
-            explained: r_cur.iter().zip(&r).map(|(a, b)| a - b).collect(),
+            delta: d.criterion(f.sse, dof) - c_cur,
+            explained: r_cur.iter().zip(&f.resid).map(|(a, b)| a - b).collect(),
+            params: params_of(&terms, &f, j),
         });
     }
-    evals
+    out
 }
 
-/// The best trial and those the run cannot tell from it (BIC change within
-/// [`AMBIGUITY_MARGIN`] of the best's, what they explain correlated with
-/// what it explains): (effect, correlation, BIC change), the best first.
-fn ambiguity_group(d: &Design, evals: &[Trial], best: usize) -> Vec<(Effect, f64, f64)> {
-    let b = &evals[best];
-    let mut group = vec![(b.term.effect, 1.0, b.delta_bic)];
-    for (i, t) in evals.iter().enumerate() {
-        if i == best || t.delta_bic > b.delta_bic + AMBIGUITY_MARGIN {
+/// The library trials the run cannot tell from `best` (plausible, within
+/// the margin, correlated): (effect, correlation, criterion change), best
+/// first.
+fn group_of(d: &Design, ts: &[Trial], best: usize) -> Vec<(Effect, f64, f64, Term)> {
+    let b = &ts[best];
+    let Some(be) = b.term.kind.effect() else {
+        return vec![];
+    };
+    let mut g = vec![(be, 1.0, b.delta, b.term)];
+    for (i, t) in ts.iter().enumerate() {
+        let Some(e) = t.term.kind.effect() else {
+            continue;
+        };
+        if i == best || t.delta > b.delta + AMBIGUITY_MARGIN || !t.plausible(d) {
             continue;
         }
-        let c = corr(&b.explained, &t.explained, &d.win.count);
+        let c = corr(&b.explained, &t.explained);
         if c.abs() >= AMBIGUITY_CORR {
-            group.push((t.term.effect, c, t.delta_bic));
+            g.push((e, c, t.delta, t.term));
         }
     }
-    group
+    g
 }
 
-/// Re-fits every non-linear parameter with the new set: over its whole
-/// grid (an effect chosen early may have bent far to imitate one chosen
-/// later: a knee fitted alone takes the linear slope's share), then
-/// locally.
-fn refit(d: &Design, chosen: &mut [Step], nuisance: &mut [Term]) {
-    let mut terms = current(chosen, nuisance);
+/// The simplest of a group: fewest parameters, then the library's order.
+fn simplest(g: &[(Effect, f64, f64, Term)]) -> usize {
+    (0..g.len())
+        .min_by_key(|&i| (g[i].0.dof(), g[i].0))
+        .unwrap_or(0)
+}
+
+/// The selection's state while it runs.
+struct State {
+    sel: Selection,
+    /// Effects and shapes that may no longer come in, and step times.
+    closed: Vec<Kind>,
+    closed_steps: Vec<f64>,
+}
+
+impl State {
+    fn removable(&self) -> Vec<(usize, Term)> {
+        let s = &self.sel;
+        let a = s.named.iter().map(|x| (0, x.term));
+        let b = s.carried.iter().map(|t| (1, *t));
+        let c = s.nuisance.iter().map(|t| (2, *t));
+        a.chain(b).chain(c).collect()
+    }
+
+    fn remove(&mut self, list: usize, t: &Term) {
+        let s = &mut self.sel;
+        match list {
+            0 => s.named.retain(|x| x.term != *t),
+            1 => {
+                s.carried.retain(|x| x != t);
+                if let Some(e) = t.kind.effect() {
+                    s.ambiguous.retain(|g| g.carried_as != e);
+                }
+            }
+            _ => s.nuisance.retain(|x| x != t),
+        }
+        self.sel.dropped.push(t.kind);
+        if t.kind == Kind::Step {
+            self.closed_steps.push(t.x);
+        } else {
+            self.closed.push(t.kind);
+        }
+    }
+}
+
+/// Re-fits every non-linear parameter with the current set: over its whole
+/// grid, then locally.
+fn refit(d: &Design, sel: &mut Selection) {
+    let mut terms = sel.terms();
     for j in 0..terms.len() {
         d.optimize(&mut terms, j);
     }
     for j in 0..terms.len() {
         d.refine(&mut terms, j);
     }
-    let nc = chosen.len();
-    for (j, t) in terms.iter().enumerate() {
-        if j < nc {
-            chosen[j].term = *t;
+    let (nn, nc) = (sel.named.len(), sel.carried.len());
+    for (j, t) in terms.into_iter().enumerate().skip(1) {
+        let i = j - 1;
+        if i < nn {
+            sel.named[i].term = t;
+        } else if i < nn + nc {
+            sel.carried[i - nn] = t;
         } else {
-            nuisance[j - nc] = *t;
+            sel.nuisance[i - nn - nc] = t;
         }
     }
 }
 
-/// Forward selection over `candidates` with variance inflation `phi`.
-pub fn select(d: &Design, candidates: &[Effect], phi: f64) -> Selection {
-    let mut chosen: Vec<Step> = vec![];
-    let mut nuisance: Vec<Term> = vec![];
-    let mut ambiguous = vec![];
-    let mut excluded: Vec<Effect> = vec![];
+/// Backward steps: drops the cheapest term while its removal costs less
+/// than [`THRESHOLD`].
+fn backward(d: &Design, st: &mut State) {
     loop {
-        let base = current(&chosen, &nuisance);
-        let Some((_, r_cur)) = d.fit(&base) else {
+        let terms = st.sel.terms();
+        let c_full = d.criterion_of(&terms);
+        let cheapest = st
+            .removable()
+            .into_iter()
+            .map(|(list, t)| {
+                let rest: Vec<Term> = terms.iter().filter(|x| **x != t).copied().collect();
+                (list, t, d.criterion_of(&rest) - c_full)
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        match cheapest {
+            Some((list, t, cost)) if cost < THRESHOLD => {
+                st.remove(list, &t);
+                refit(d, &mut st.sel);
+            }
+            _ => return,
+        }
+    }
+}
+
+/// Named effects whose parameters left their range after later
+/// additions: moved to the nuisance terms, reported implausible.
+fn recheck(d: &Design, st: &mut State) {
+    let terms = st.sel.terms();
+    let Some(f) = d.fit(&terms) else {
+        return;
+    };
+    let mut moved = vec![];
+    for (j, t) in terms.iter().enumerate() {
+        let Some(e) = t.kind.effect() else {
+            continue;
+        };
+        if !st.sel.named.iter().any(|s| s.term == *t) {
+            continue;
+        }
+        let p = params_of(&terms, &f, j);
+        let out = ranges::outside(e, &p, &d.extent);
+        if !out.is_empty() {
+            st.sel.implausible.push(Implausible {
+                effect: e,
+                parameters: p.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+                outside: out,
+            });
+            moved.push(*t);
+        }
+    }
+    for t in moved {
+        st.sel.named.retain(|s| s.term != t);
+        st.sel.nuisance.push(t);
+        st.closed.push(t.kind);
+    }
+}
+
+/// The open candidates: library effects and shapes not in or closed, and
+/// the steps offered.
+fn open(d: &Design, candidates: &[Effect], st: &State) -> Vec<Term> {
+    let inside = st.sel.terms();
+    let taken = |k: Kind| st.closed.contains(&k) || inside.iter().any(|t| t.kind == k);
+    let mut v: Vec<Term> = candidates
+        .iter()
+        .map(|&e| Kind::Effect(e))
+        .chain(
+            Shape::ALL
+                .into_iter()
+                .filter(|s| s.available(d.inp))
+                .map(Kind::Shape),
+        )
+        .filter(|&k| !taken(k))
+        .map(Term::of)
+        .collect();
+    // Steps: those found after the first pass, and where the current
+    // residual's level jumps most (a step is searched for like a knee).
+    let n_steps = inside.iter().filter(|t| t.kind == Kind::Step).count();
+    if n_steps < MAX_STEPS && st.closed_steps.is_empty() {
+        let mut xs = d.steps.clone();
+        if let Some(f) = d.fit(&inside) {
+            let parts = d.parts(&inside, &f.coef);
+            let e: Vec<f64> = (0..d.r.len())
+                .map(|k| d.r[k] - parts.iter().map(|p| p[k]).sum::<f64>())
+                .collect();
+            xs.extend(step_peaks(d.win, &e, white_sigma(&e), 4.0, 3));
+            xs.extend(cusum_peaks(d.win, &e, 2));
+        }
+        for x in xs {
+            let t = Term {
+                kind: Kind::Step,
+                x,
+            };
+            if !inside.contains(&t) && !v.contains(&t) {
+                v.push(t);
+            }
+        }
+    }
+    v
+}
+
+/// Stepwise selection over `candidates` (library effects; not the bias,
+/// whose constant every fit carries).
+pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
+    let mut st = State {
+        sel: Selection {
+            named: vec![],
+            carried: vec![],
+            nuisance: vec![],
+            ambiguous: vec![],
+            implausible: vec![],
+            dropped: vec![],
+        },
+        closed: vec![],
+        closed_steps: vec![],
+    };
+    for _ in 0..4 * (candidates.len() + Shape::ALL.len() + d.steps.len() + 2) {
+        let base = st.sel.terms();
+        let Some(cur) = d.fit(&base) else {
             break;
         };
-        let sse_cur = weighted_sse(d, &r_cur);
-        if sse_cur <= 0.0 {
-            break;
-        }
-        let open =
-            |e: Effect| !(excluded.contains(&e) || chosen.iter().any(|s| s.term.effect == e));
-        let evals = trials(d, candidates, open, &base, (&r_cur, sse_cur), phi);
-        let Some(best) = evals
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.delta_bic.total_cmp(&b.1.delta_bic))
-            .map(|(i, _)| i)
+        let c_cur = d.criterion_of(&base);
+        let ts = trials(d, &open(d, candidates, &st), &base, &cur.resid, c_cur);
+        let Some(mut best) = (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta))
         else {
             break;
         };
-        let (bt, bdbic) = (evals[best].term, evals[best].delta_bic);
-        if bdbic > -BIC_THRESHOLD {
+        if ts[best].delta > -THRESHOLD {
             break;
         }
-        let group = ambiguity_group(d, &evals, best);
-        if group.len() > 1 {
-            ambiguous.push(Ambiguous {
-                effects: group.iter().map(|g| g.0).collect(),
-                correlation: group.iter().map(|g| g.1).collect(),
-                delta_bic: group.iter().map(|g| g.2).collect(),
-                suggestion: separation(group[0].0, group[1].0),
-            });
-            excluded.extend(group.iter().map(|g| g.0));
-            nuisance.push(bt);
-        } else {
-            chosen.push(Step {
-                term: bt,
-                delta_bic: bdbic,
-            });
+        // A shape yields to an effect that explains the same as well.
+        if ts[best].term.kind.effect().is_none() {
+            let rival = (0..ts.len())
+                .filter(|&i| {
+                    ts[i].term.kind.effect().is_some()
+                        && ts[i].delta <= ts[best].delta + AMBIGUITY_MARGIN
+                        && ts[i].delta < -THRESHOLD
+                        && ts[i].plausible(d)
+                        && corr(&ts[i].explained, &ts[best].explained).abs() >= AMBIGUITY_CORR
+                })
+                .min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta));
+            match rival {
+                Some(i) => best = i,
+                None => {
+                    st.sel.nuisance.push(ts[best].term);
+                    refit(d, &mut st.sel);
+                    backward(d, &mut st);
+                    continue;
+                }
+            }
         }
-        refit(d, &mut chosen, &mut nuisance);
+        let b = &ts[best];
+        let Some(e) = b.term.kind.effect() else {
+            break;
+        };
+        if !b.plausible(d) {
+            st.sel.implausible.push(Implausible {
+                effect: e,
+                parameters: b.params.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+                outside: ranges::outside(e, &b.params, &d.extent),
+            });
+            st.sel.nuisance.push(b.term);
+            st.closed.push(b.term.kind);
+        } else {
+            let g = group_of(d, &ts, best);
+            if g.len() > 1 {
+                let rep = simplest(&g);
+                st.sel.ambiguous.push(Ambiguous {
+                    effects: g.iter().map(|x| x.0).collect(),
+                    correlation: g.iter().map(|x| x.1).collect(),
+                    delta_bic: g.iter().map(|x| x.2).collect(),
+                    suggestion: separation(g[0].0, g[1].0),
+                    carried_as: g[rep].0,
+                });
+                st.sel.carried.push(g[rep].3);
+                st.closed.extend(g.iter().map(|x| Kind::Effect(x.0)));
+            } else {
+                st.sel.named.push(Step {
+                    term: b.term,
+                    delta_bic: b.delta,
+                });
+            }
+        }
+        refit(d, &mut st.sel);
+        backward(d, &mut st);
+        recheck(d, &mut st);
     }
-    Selection {
-        chosen,
-        nuisance,
-        ambiguous,
-        inflation: phi,
-    }
+    st.sel
 }

@@ -1,0 +1,534 @@
+//! The residual's own noise, as the criterion and the intervals see it
+//! (docs/discovery.md): the window means of the residual are an effect's
+//! regressors times its parameters plus noise, and the noise is what the
+//! Allan analysis of the residual says it is (IEEE 952 terms):
+//!
+//! - white (quantization and angle random walk): variance
+//!   `2 Q^2/tau^2 + N^2/tau` for a window of tau, scaled by the window's
+//!   share of rows;
+//! - bias instability (flicker, two-sided PSD B^2/(2 pi f)): a sum of
+//!   first-order Markov processes with correlation times spaced by
+//!   r = sqrt(10) from 2 s to the record's length, each of variance
+//!   B^2 ln(r)/pi (Lorentzians of equal variance spaced by r sum to
+//!   sigma^2/(2 f ln r): the flat Allan floor);
+//! - rate random walk: a Wiener process of increments K^2 dt, starting at
+//!   zero (its start is the constant every fit carries);
+//! - exponentially correlated (first-order Markov) noise of variance q^2
+//!   and correlation time T_c (physics.md 3: a random walk below T_c, white
+//!   above; what a regressor's own filtered sensor noise leaves, among
+//!   others).
+//!
+//! The terms are fitted to the residual's Allan variance here
+//! ([`fit_terms`], on the noise analysis's estimator), every term kept;
+//! then, given the terms of a selection, the random walk, flicker and
+//! Markov levels are refined by maximum likelihood ([`refine`]): the
+//! innovations' likelihood weighs the slowest frequencies, where the
+//! Allan curve has the fewest estimates.
+//!
+//! Generalised least squares with this covariance is ordinary least squares
+//! on the Kalman filter's standardised innovations: [`Whitener`] runs the
+//! filter's gains (they do not depend on the data) over any column. A
+//! random walk then makes a slow shape cheap to imitate, and a record-long
+//! drift stops passing for a warm-up.
+
+use super::windows::Windows;
+use crate::noise::adev::{averaging_factors, oavar};
+use crate::noise::edf::edf_oavar;
+use crate::noise::terms::{basis, COUNT};
+
+/// Spacing of the flicker approximation's correlation times.
+const FLICKER_SPACING: f64 = 3.162_277_660_168_379_5;
+/// Shortest flicker correlation time, s (faster ones are white in a 1 s mean).
+const FLICKER_MIN_S: f64 = 2.0;
+
+/// The noise of the residual's window means.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct NoiseModel {
+    /// Variance of a full window's mean from white noise, (deg/s)^2.
+    pub white: f64,
+    /// Flicker B^2, (deg/s)^2.
+    pub flicker: f64,
+    /// Random-walk K^2, (deg/s)^2/s.
+    pub random_walk: f64,
+    /// Markov variance q^2, (deg/s)^2, and correlation time, s.
+    pub markov: f64,
+    pub markov_s: f64,
+}
+
+impl NoiseModel {
+    /// White noise of the window means' robust scatter (half the median
+    /// squared difference of neighbours over the chi-square median): the
+    /// first pass, before anything is known of the residual's colour.
+    pub fn white_of(means: &[f64], keep: &[bool]) -> Self {
+        let m: Vec<f64> = means
+            .iter()
+            .zip(keep)
+            .filter(|(_, k)| **k)
+            .map(|(v, _)| *v)
+            .collect();
+        let mut d2: Vec<f64> = m.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
+        d2.sort_by(f64::total_cmp);
+        let white = d2
+            .get(d2.len() / 2)
+            .map_or(1e-12, |v| v / (2.0 * 0.454_936))
+            .max(1e-30);
+        Self {
+            white,
+            flicker: 0.0,
+            random_walk: 0.0,
+            markov: 0.0,
+            markov_s: 1.0,
+        }
+    }
+
+    /// From the Allan variance of a residual's window means `means` (the
+    /// windows `keep` says; spikes left out), `tau0` s apart: the IEEE 952
+    /// terms fitted by [`fit_terms`] to the curve up to a tenth of the
+    /// record. The rate ramp is
+    /// fitted but left out of the model: a drift is a shape for the fit to
+    /// find, not noise. Falls back to [`Self::white_of`] where the record
+    /// is too short.
+    pub fn from_residual(means: &[f64], keep: &[bool], tau0: f64) -> Self {
+        let m: Vec<f64> = means
+            .iter()
+            .zip(keep)
+            .filter(|(_, k)| **k)
+            .map(|(v, _)| *v)
+            .collect();
+        let white = Self::white_of(means, keep);
+        if m.len() < 64 {
+            return white;
+        }
+        // Averaging times up to a fifth of the record: beyond, the few
+        // independent estimates are the ones the fit's slow shapes have
+        // emptied (the likelihood of [`refine`] sees those).
+        let ms: Vec<usize> = averaging_factors(m.len(), 10)
+            .into_iter()
+            .filter(|&k| k <= m.len() / 5)
+            .collect();
+        let taus: Vec<f64> = ms.iter().map(|&k| k as f64 * tau0).collect();
+        let avar = oavar(&m, &ms);
+        let Some((c, mk)) = fit_terms(&taus, &avar, &ms, m.len() + 1) else {
+            return white;
+        };
+        let w = 2.0 * c[0] / (tau0 * tau0) + c[1] / tau0;
+        Self {
+            white: if w > 0.0 { w } else { white.white },
+            flicker: c[2],
+            random_walk: c[3],
+            markov: mk.0,
+            markov_s: mk.1,
+        }
+    }
+
+    /// Standard deviation of a mean over `tau` s of stationary noise
+    /// (white and flicker; a random walk wanders, it has no level to
+    /// deviate from), deg/s.
+    pub fn sd_of_mean(&self, tau: f64, window_s: f64) -> f64 {
+        let fl = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI * self.flicker;
+        let tc = self.markov_s.max(1e-9);
+        let x = tau.max(window_s) / tc;
+        let mk = self.markov * 2.0 / x * (1.0 - (1.0 - (-x).exp()) / x);
+        (self.white * window_s / tau.max(window_s) + fl + mk).sqrt()
+    }
+}
+
+/// Allan variance of first-order Markov noise of unit variance and
+/// correlation time `tc` at `tau`: physics.md 3's `(q_c T_c)^2/tau (1 -
+/// T_c/(2 tau) (3 - 4 e^(-tau/T_c) + e^(-2 tau/T_c)))` with the driving
+/// density q_c^2 = 2 sigma^2/T_c of a process of variance sigma^2.
+pub fn markov_avar(tau: f64, tc: f64) -> f64 {
+    let x = tau / tc;
+    2.0 * tc / tau * (1.0 - (3.0 - 4.0 * (-x).exp() + (-2.0 * x).exp()) / (2.0 * x))
+}
+
+/// The five IEEE 952 coefficients (Q^2, N^2, B^2, K^2, R^2) and a
+/// first-order Markov term (q^2, T_c) fitted to an Allan variance curve
+/// `avar` at `taus` (averaging factors `ms`, `n_phase` angle points):
+/// non-negative weighted least squares (the best of the subsets whose
+/// solution is non-negative, T_c on a grid), reweighted twice at the model
+/// (an estimate's variance 2 AVAR^2/edf). Unlike the noise analysis's
+/// reported terms, no term is dropped for carrying less than half the
+/// curve: a bias instability that white noise hides at every measured
+/// averaging time still widens the interval of a record-long bias.
+pub fn fit_terms(
+    taus: &[f64],
+    avar: &[f64],
+    ms: &[usize],
+    n_phase: usize,
+) -> Option<([f64; COUNT], (f64, f64))> {
+    let n = taus.len();
+    if n < 3 {
+        return None;
+    }
+    let edf: Vec<f64> = ms
+        .iter()
+        .map(|&m| edf_oavar(0, m, n_phase).max(1.0))
+        .collect();
+    let (t_lo, t_hi) = (taus[0] * 2.0, taus[n - 1] / 2.0);
+    let mut tcs = vec![0.0];
+    if t_hi > t_lo {
+        tcs.extend((0..10).map(|i| t_lo * (t_hi / t_lo).powf(i as f64 / 9.0)));
+    }
+    let mut model = avar.to_vec();
+    let mut best = None;
+    for _ in 0..3 {
+        let w: Vec<f64> = (0..n)
+            .map(|i| edf[i] / (2.0 * model[i].max(1e-300).powi(2)))
+            .collect();
+        let mut fit: Option<([f64; COUNT], (f64, f64), f64)> = None;
+        for &tc in &tcs {
+            let terms = COUNT + usize::from(tc > 0.0);
+            for mask in 1u32..(1 << terms) {
+                let sub: Vec<usize> = (0..terms).filter(|j| mask & (1 << j) != 0).collect();
+                if sub.len() > n {
+                    continue;
+                }
+                let cols: Vec<Vec<f64>> = sub
+                    .iter()
+                    .map(|&j| {
+                        taus.iter()
+                            .map(|&t| {
+                                if j < COUNT {
+                                    basis(j, t)
+                                } else {
+                                    markov_avar(t, tc)
+                                }
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let Some(f) = crate::numerics::lsq::wls(&cols, avar, Some(&w)) else {
+                    continue;
+                };
+                if f.coef.iter().any(|&c| c < 0.0) || fit.as_ref().is_some_and(|b| b.2 <= f.sse) {
+                    continue;
+                }
+                let mut c = [0.0; COUNT];
+                let mut mk = (0.0, 1.0);
+                for (k, &j) in sub.iter().enumerate() {
+                    if j < COUNT {
+                        c[j] = f.coef[k];
+                    } else {
+                        mk = (f.coef[k], tc);
+                    }
+                }
+                fit = Some((c, mk, f.sse));
+            }
+        }
+        let (c, mk, _) = fit?;
+        model = taus
+            .iter()
+            .map(|&t| {
+                (0..COUNT).map(|j| c[j] * basis(j, t)).sum::<f64>() + mk.0 * markov_avar(t, mk.1)
+            })
+            .collect();
+        best = Some((c, mk));
+    }
+    best
+}
+
+/// The noise model, given the terms of a fit (their raw columns `cols`
+/// and the residual less their fixed parts `y`, window means), with its
+/// random walk, flicker and Markov levels refined by maximum likelihood
+/// (each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
+/// twice; the white level profiled out as the common scale).
+pub fn refine(
+    start: &NoiseModel,
+    win: &Windows,
+    keep: &[bool],
+    y: &[f64],
+    cols: &[Vec<f64>],
+) -> NoiseModel {
+    let loglik = |m: &NoiseModel| -> f64 {
+        let w = Whitener::new(m, win, keep);
+        let yw = w.whiten(y);
+        let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
+        let sse = match super::normal::normal_solve(&cw, &yw) {
+            Some(b) if !cw.is_empty() => {
+                let mut r = yw.clone();
+                for (c, bj) in cw.iter().zip(&b) {
+                    for (a, v) in r.iter_mut().zip(c) {
+                        *a -= bj * v;
+                    }
+                }
+                r.iter().map(|v| v * v).sum::<f64>()
+            }
+            _ => yw.iter().map(|v| v * v).sum::<f64>(),
+        };
+        let n = w.used() as f64;
+        -0.5 * (n * (sse / n).max(1e-300).ln() + w.log_det())
+    };
+    let mut m = *start;
+    let floor = m.white * 1e-4;
+    let mut best = loglik(&m);
+    let factors: Vec<f64> = std::iter::once(0.0)
+        .chain((0..=16).map(|i| 10f64.powf(-2.0 + 0.25 * i as f64)))
+        .collect();
+    for _ in 0..2 {
+        for which in 0..3 {
+            let base = match which {
+                0 => m.random_walk.max(floor * 1e-3),
+                1 => m.flicker.max(floor),
+                _ => m.markov.max(floor),
+            };
+            for &f in &factors {
+                let mut c = m;
+                match which {
+                    0 => c.random_walk = base * f,
+                    1 => c.flicker = base * f,
+                    _ => c.markov = base * f,
+                }
+                let l = loglik(&c);
+                if l > best + 1e-9 {
+                    best = l;
+                    m = c;
+                }
+            }
+        }
+    }
+    m
+}
+
+/// The Kalman filter's gains for a noise model over a run's windows: it
+/// turns any column of window means into its standardised innovations.
+pub struct Whitener {
+    /// States: the random walk, then the flicker processes.
+    states: usize,
+    /// Per window: each state's transition factor, the gains, and
+    /// 1/sqrt(innovation variance) (0 for a window left out).
+    phi: Vec<f64>,
+    gain: Vec<f64>,
+    inv_sd: Vec<f64>,
+    /// Sum of the logarithms of the innovation variances.
+    log_det: f64,
+    pub keep: Vec<bool>,
+}
+
+impl Whitener {
+    /// The gains of `noise` over windows `win` (mid times, row counts),
+    /// using the windows `keep` marks.
+    pub fn new(noise: &NoiseModel, win: &Windows, keep: &[bool]) -> Self {
+        let n = win.len();
+        let span = if n > 1 { win.t[n - 1] - win.t[0] } else { 1.0 };
+        let mut taus: Vec<f64> = vec![];
+        if noise.flicker > 0.0 {
+            let mut tc = FLICKER_MIN_S;
+            while tc <= span.max(FLICKER_MIN_S) * FLICKER_SPACING {
+                taus.push(tc);
+                tc *= FLICKER_SPACING;
+            }
+        }
+        let var_fl = noise.flicker * FLICKER_SPACING.ln() / std::f64::consts::PI;
+        // The Markov process last, its own variance.
+        let mk = noise.markov > 0.0;
+        let mut vars = vec![var_fl; taus.len()];
+        if mk {
+            taus.push(noise.markov_s.max(1e-6));
+            vars.push(noise.markov);
+        }
+        let s = 1 + taus.len();
+        let mut counts: Vec<f64> = win.count.clone();
+        counts.sort_by(f64::total_cmp);
+        let nominal = counts.get(counts.len() / 2).copied().unwrap_or(1.0);
+        // P: covariance of the state prediction (s x s, row-major).
+        let mut p = vec![0.0; s * s];
+        for i in 1..s {
+            p[i * s + i] = vars[i - 1];
+        }
+        let mut phi = vec![1.0; n * s];
+        let mut gain = vec![0.0; n * s];
+        let mut inv_sd = vec![0.0; n];
+        let mut log_det = 0.0;
+        let mut ph = vec![1.0; s];
+        for k in 0..n {
+            if k > 0 {
+                let dt = (win.t[k] - win.t[k - 1]).max(0.0);
+                ph[0] = 1.0;
+                for (i, tc) in taus.iter().enumerate() {
+                    ph[i + 1] = (-dt / tc).exp();
+                }
+                for i in 0..s {
+                    for j in 0..s {
+                        p[i * s + j] *= ph[i] * ph[j];
+                    }
+                }
+                p[0] += noise.random_walk * dt;
+                for i in 1..s {
+                    p[i * s + i] += vars[i - 1] * (1.0 - ph[i] * ph[i]);
+                }
+                phi[k * s..(k + 1) * s].copy_from_slice(&ph);
+            }
+            if !keep[k] {
+                continue;
+            }
+            // Observation: the sum of the states plus white noise.
+            let ph1: Vec<f64> = (0..s).map(|i| (0..s).map(|j| p[i * s + j]).sum()).collect();
+            let f = ph1.iter().sum::<f64>() + noise.white * nominal / win.count[k].max(1e-9);
+            if f <= 0.0 || !f.is_finite() {
+                continue;
+            }
+            for i in 0..s {
+                gain[k * s + i] = ph1[i] / f;
+            }
+            for i in 0..s {
+                for j in 0..s {
+                    p[i * s + j] -= ph1[i] * ph1[j] / f;
+                }
+            }
+            inv_sd[k] = 1.0 / f.sqrt();
+            log_det += f.ln();
+        }
+        Self {
+            states: s,
+            phi,
+            gain,
+            inv_sd,
+            log_det,
+            keep: keep.to_vec(),
+        }
+    }
+
+    /// The standardised innovations of `x` (one value per window; 0 for
+    /// a window left out).
+    pub fn whiten(&self, x: &[f64]) -> Vec<f64> {
+        let s = self.states;
+        let mut a = vec![0.0; s];
+        let mut out = vec![0.0; x.len()];
+        for (k, &xk) in x.iter().enumerate() {
+            if k > 0 {
+                for (ai, f) in a.iter_mut().zip(&self.phi[k * s..(k + 1) * s]) {
+                    *ai *= f;
+                }
+            }
+            if !self.keep[k] || self.inv_sd[k] == 0.0 {
+                continue;
+            }
+            let v = xk - a.iter().sum::<f64>();
+            out[k] = v * self.inv_sd[k];
+            for (ai, g) in a.iter_mut().zip(&self.gain[k * s..(k + 1) * s]) {
+                *ai += g * v;
+            }
+        }
+        out
+    }
+
+    /// Sum of the logarithms of the innovation variances (the
+    /// determinant in the likelihood).
+    pub fn log_det(&self) -> f64 {
+        self.log_det
+    }
+
+    /// Windows used.
+    pub fn used(&self) -> usize {
+        self.inv_sd.iter().filter(|v| **v > 0.0).count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_core::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    fn windows(n: usize) -> Windows {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 + 0.5).collect();
+        Windows::new(&t, 1.0)
+    }
+
+    #[test]
+    fn white_noise_is_scaled_and_a_random_walk_differenced() {
+        let win = windows(400);
+        let keep = vec![true; 400];
+        // White only: whitening divides by the standard deviation.
+        let w = Whitener::new(
+            &NoiseModel {
+                white: 4.0,
+                flicker: 0.0,
+                random_walk: 0.0,
+                markov: 0.0,
+                markov_s: 1.0,
+            },
+            &win,
+            &keep,
+        );
+        let x: Vec<f64> = (0..400).map(|k| k as f64).collect();
+        let y = w.whiten(&x);
+        assert!((y[7] - 3.5).abs() < 1e-12);
+        // A pure random walk (no white noise to speak of): the innovations
+        // are its increments over their standard deviation.
+        let rw = NoiseModel {
+            white: 1e-12,
+            flicker: 0.0,
+            random_walk: 0.25,
+            markov: 0.0,
+            markov_s: 1.0,
+        };
+        let w = Whitener::new(&rw, &win, &keep);
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
+        let mut level = 0.0;
+        let walk: Vec<f64> = (0..400)
+            .map(|_| {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                level += 0.5 * z;
+                level
+            })
+            .collect();
+        let y = w.whiten(&walk);
+        // GLS innovations of the model that made the data: unit variance.
+        let var = y[1..].iter().map(|v| v * v).sum::<f64>() / 399.0;
+        assert!((var - 1.0).abs() < 0.2, "{var}");
+        for k in 2..400 {
+            assert!(((walk[k] - walk[k - 1]) / 0.5 - y[k]).abs() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn markov_allan_variance_limits() {
+        // Below T_c a random walk of K^2 = 2 sigma^2/T_c (K^2 tau/3), above
+        // it white noise of N^2 = 2 sigma^2 T_c (N^2/tau).
+        let tc = 100.0;
+        let a = markov_avar(0.1, tc);
+        assert!((a / (2.0 / tc * 0.1 / 3.0) - 1.0).abs() < 1e-3, "{a}");
+        let b = markov_avar(1e5, tc);
+        assert!((b / (2.0 * tc / 1e5) - 1.0).abs() < 2e-3, "{b}");
+    }
+
+    #[test]
+    fn flicker_innovations_are_white() {
+        // The project's flicker generator through the filter of the noise
+        // model fitted to its own record: the standardised innovations
+        // have unit variance and no lag-1 or long-range correlation left.
+        let n = 20_000;
+        let b = 1e-3;
+        let mut g = gyro_sim::RateNoise::new(
+            gyro_sim::NoiseParams {
+                n_dps_rts: 3e-3,
+                b_dps: b,
+                flicker_max_tau_s: n as f64,
+                ..Default::default()
+            },
+            1.0,
+            11,
+        );
+        let x: Vec<f64> = (0..n).map(|_| g.sample()).collect();
+        let win = windows(n);
+        let keep = vec![true; n];
+        let m = NoiseModel::from_residual(&x, &keep, 1.0);
+        // The flicker found is the generator's, within its estimate's
+        // scatter.
+        assert!((m.flicker.sqrt() / b - 1.0).abs() < 0.5, "{m:?}");
+        let y = Whitener::new(&m, &win, &keep).whiten(&x);
+        let var = y.iter().map(|v| v * v).sum::<f64>() / n as f64;
+        assert!((var - 1.0).abs() < 0.1, "{var}");
+        let r1 = y.windows(2).map(|p| p[0] * p[1]).sum::<f64>() / (n as f64 * var);
+        assert!(r1.abs() < 0.05, "{r1}");
+        // Means of 500 innovations: their scatter is that of white noise.
+        let blocks: Vec<f64> = y
+            .chunks_exact(500)
+            .map(|c| c.iter().sum::<f64>() / 500f64.sqrt())
+            .collect();
+        let bv = blocks.iter().map(|v| v * v).sum::<f64>() / blocks.len() as f64;
+        assert!(bv < 2.0, "{bv}");
+    }
+}

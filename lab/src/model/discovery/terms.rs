@@ -1,0 +1,171 @@
+//! What a discovery fit is made of: the constant every fit carries, the
+//! library's effects (effects.rs), and shapes the library has no name
+//! for. A shape is a rival, never a name: when the residual is better
+//! explained by the rate squared, the rate cubed, a ramp in time, the
+//! temperature squared, a temperature's curvature or a step than by any
+//! effect, it is taken as what no effect of the library explains, so that
+//! no effect is bent to imitate it (docs/discovery.md).
+
+use crate::data::run_file::Column;
+use crate::model::effects::Effect;
+use crate::model::inputs::{centered_slope, Inputs, RATE_HALF_WIDTH_S};
+
+/// A rate the run must reach to show a rate-dependent term, deg/s (the
+/// Earth rate is 0.004 deg/s).
+pub const ROTATING_DPS: f64 = 0.5;
+/// Half width of the slopes that make a temperature's curvature, s: a
+/// second difference of a sensor read in hundredths of a degree is noise
+/// over the temperature's own slope's 30 s; a thermal lag's curvature
+/// lives over minutes.
+pub const CURVATURE_HALF_WIDTH_S: f64 = 120.0;
+
+/// A shape of the inputs no effect of the library has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Shape {
+    RateSquared,
+    RateCubed,
+    Ramp,
+    TimeSquared,
+    TempSquared,
+    TempCurvature,
+    CaseSquared,
+    CaseRate,
+    CaseCurvature,
+}
+
+impl Shape {
+    pub const ALL: [Shape; 9] = [
+        Shape::RateSquared,
+        Shape::RateCubed,
+        Shape::Ramp,
+        Shape::TimeSquared,
+        Shape::TempSquared,
+        Shape::TempCurvature,
+        Shape::CaseSquared,
+        Shape::CaseRate,
+        Shape::CaseCurvature,
+    ];
+
+    /// What the shape follows, in the run's terms.
+    pub fn describe(self) -> String {
+        let t = Column::Temp.name();
+        let c = Column::Case.name();
+        let w = Column::RefRate.name();
+        match self {
+            Shape::RateSquared => format!("{w}^2 (a rate-squared term)"),
+            Shape::RateCubed => format!("{w}^3 (a rate-cubed term)"),
+            Shape::Ramp => format!("{} (a drift linear in time)", Column::Time.name()),
+            Shape::TimeSquared => format!("{}^2 (a drift curving in time)", Column::Time.name()),
+            Shape::TempSquared => format!("({t} - 20)^2"),
+            Shape::TempCurvature => format!("d2({t})/dt2"),
+            Shape::CaseSquared => format!("({c} - 20)^2"),
+            Shape::CaseRate => format!("d({c})/dt"),
+            Shape::CaseCurvature => format!("d2({c})/dt2"),
+        }
+    }
+
+    /// Whether the run can show it.
+    pub fn available(self, inp: &Inputs) -> bool {
+        match self {
+            Shape::RateSquared | Shape::RateCubed => rotating(inp),
+            Shape::Ramp | Shape::TimeSquared => true,
+            Shape::TempSquared | Shape::TempCurvature => inp.temp.is_some(),
+            Shape::CaseSquared | Shape::CaseRate | Shape::CaseCurvature => inp.case.is_some(),
+        }
+    }
+
+    /// The shape's column, one value per row (its scale is arbitrary: it is
+    /// never reported as a parameter), zero where the input is at its
+    /// reference (the record's start, no rate, 20 degC, no change): the
+    /// constant is the bias there.
+    pub fn column(self, inp: &Inputs) -> Vec<f64> {
+        let n = inp.len();
+        let t0 = inp.t.first().copied().unwrap_or(0.0);
+        let span = (inp.t.last().copied().unwrap_or(1.0) - t0).max(1.0);
+        let zeros = vec![0.0; n];
+        let temp = inp.temp.as_ref().unwrap_or(&zeros);
+        let case = inp.case.as_ref().unwrap_or(&zeros);
+        let w = &inp.w;
+        match self {
+            Shape::RateSquared => w.iter().map(|x| x * x).collect(),
+            Shape::RateCubed => w.iter().map(|x| x * x * x).collect(),
+            // From the record's start: the constant is then the bias there.
+            Shape::Ramp => inp.t.iter().map(|t| (t - t0) / span).collect(),
+            Shape::TimeSquared => inp.t.iter().map(|t| ((t - t0) / span).powi(2)).collect(),
+            Shape::TempSquared => temp.iter().map(|x| (x - 20.0).powi(2)).collect(),
+            Shape::CaseSquared => case.iter().map(|x| (x - 20.0).powi(2)).collect(),
+            Shape::TempCurvature => {
+                let r = centered_slope(&inp.t, temp, CURVATURE_HALF_WIDTH_S);
+                centered_slope(&inp.t, &r, CURVATURE_HALF_WIDTH_S)
+            }
+            Shape::CaseRate => centered_slope(&inp.t, case, RATE_HALF_WIDTH_S),
+            Shape::CaseCurvature => {
+                let r = centered_slope(&inp.t, case, CURVATURE_HALF_WIDTH_S);
+                centered_slope(&inp.t, &r, CURVATURE_HALF_WIDTH_S)
+            }
+        }
+    }
+}
+
+/// Whether the run turns: reaches [`ROTATING_DPS`].
+pub fn rotating(inp: &Inputs) -> bool {
+    inp.w.iter().any(|w| w.abs() >= ROTATING_DPS)
+}
+
+/// What a term of the fit is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kind {
+    /// The constant every fit carries (a bias's column).
+    Constant,
+    Effect(Effect),
+    Shape(Shape),
+    /// A step of the output at time x.
+    Step,
+    /// The warm-up's decaying form, exp(-t/x): with the constant, the same
+    /// as the warm-up's A (1 - exp(-t/x)); alone, a warm-up that settles
+    /// to no bias.
+    Decay,
+}
+
+impl Kind {
+    /// Whether the term is one of the library's effects.
+    pub fn effect(self) -> Option<Effect> {
+        match self {
+            Kind::Effect(e) => Some(e),
+            _ => None,
+        }
+    }
+
+    /// Free parameters.
+    pub fn dof(self) -> usize {
+        match self {
+            Kind::Effect(e) => e.dof(),
+            Kind::Step | Kind::Decay => 2,
+            _ => 1,
+        }
+    }
+
+    /// Its name in the report.
+    pub fn describe(self) -> String {
+        match self {
+            Kind::Constant => "constant".into(),
+            Kind::Effect(e) => e.name().into(),
+            Kind::Shape(s) => s.describe(),
+            Kind::Step => "a step".into(),
+            Kind::Decay => "a decaying warm-up".into(),
+        }
+    }
+}
+
+/// A term at its non-linear parameter (the effect's, or a step's time).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Term {
+    pub kind: Kind,
+    pub x: f64,
+}
+
+impl Term {
+    pub fn of(kind: Kind) -> Self {
+        Self { kind, x: 0.0 }
+    }
+}
