@@ -37,8 +37,12 @@ pub struct Design<'a> {
     /// the whitened residual ([`inflation`]), at least 1.
     pub phi: f64,
     /// Whitened columns of the terms without a non-linear parameter.
-    fixed: HashMap<String, (Vec<Vec<f64>>, Option<Vec<f64>>)>,
+    fixed: HashMap<String, Whitened>,
 }
+
+/// A term's whitened columns, and its whitened derivative column when it
+/// has a non-linear parameter.
+type Whitened = (Vec<Vec<f64>>, Option<Vec<f64>>);
 
 /// A joint fit: coefficients (in the terms' order, their columns in
 /// turn) and the whitened residual and its sum of squares.
@@ -352,7 +356,8 @@ pub fn inflation(r: &[f64], keep: &[bool]) -> f64 {
         return 1.0;
     }
     let v1 = var(&x);
-    if !(v1 > 0.0) {
+    // NaN or zero variance: no inflation to estimate.
+    if v1.is_nan() || v1 <= 0.0 {
         return 1.0;
     }
     let mut phi: f64 = 1.0;

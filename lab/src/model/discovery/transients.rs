@@ -136,7 +136,7 @@ pub fn find(win: &Windows, e: &[f64]) -> Transients {
         return Transients::default();
     }
     let sigma = white_sigma(e);
-    if !(sigma > 0.0) {
+    if sigma.is_nan() || sigma <= 0.0 {
         return Transients::default();
     }
     // Spikes: far from the local median (15 windows either side).

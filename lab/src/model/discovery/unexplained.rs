@@ -137,9 +137,7 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         }
     }
     for &(a, b) in src.spikes {
-        for k in a..=b {
-            u[k] = src.after[k];
-        }
+        u[a..=b].copy_from_slice(&src.after[a..=b]);
     }
     // Blocks where the whitened residual still stands out.
     let sd = (BLOCK_WINDOWS as f64 * src.scale.max(1e-300)).sqrt();
