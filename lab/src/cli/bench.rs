@@ -167,6 +167,63 @@ fn print_scale_factor(j: &ScaleFactorBench) {
         "no-knee gyro fitted with no knee: {}/{n}",
         j.no_knee_fitted_without_knee
     );
+    print_families(j);
+}
+
+/// The model families' table: per coil, the model chosen against the
+/// truth's, the knee, the curvature, the table and the validation.
+fn print_families(j: &ScaleFactorBench) {
+    let n = j.seeds;
+    println!();
+    println!(
+        "model families (fit: cycle, +-50 deg/s; validation: steps, -100 deg/s; RMS of 60 s means)"
+    );
+    println!(
+        "{:<26} {:<26} {:>9} {:>14} {:>16} {:>22} {:>12} {:>16}",
+        "coil",
+        "expected model",
+        "right",
+        "chosen K/P/PK",
+        "knee err degC",
+        "curvature (95 % cov.)",
+        "table nodes",
+        "validation ppm"
+    );
+    for r in &j.families {
+        let knee = if r.knee_abs_err_c.n > 0 {
+            format!(
+                "{:.3} / {:.3} ({}/{})",
+                r.knee_abs_err_c.mean, r.knee_abs_err_c.max, r.knee_ci_covers, r.knee_abs_err_c.n
+            )
+        } else {
+            "-".into()
+        };
+        let curv = if r.curvature.n > 0 {
+            format!(
+                "{:.2e} vs {:.2e} ({}/{})",
+                r.curvature.mean, r.curvature_truth, r.curvature_ci_covers, r.curvature.n
+            )
+        } else {
+            "-".into()
+        };
+        println!(
+            "{:<26} {:<26} {:>9} {:>14} {:>16} {:>22} {:>12} {:>16}",
+            r.coil,
+            format!("{} degree {}", r.expected_model, r.expected_degree),
+            format!("{}/{n}", r.right_model),
+            format!("{}/{}/{}", r.chosen[0], r.chosen[1], r.chosen[2]),
+            knee,
+            curv,
+            format!(
+                "{:.0} ({:.3} ppm)",
+                r.table_nodes.mean, r.tabulation_ppm.max
+            ),
+            format!(
+                "{:.3} +- {:.3} (max {:.3})",
+                r.validation_ppm.mean, r.validation_ppm.sd, r.validation_ppm.max
+            ),
+        );
+    }
 }
 
 #[derive(Args, Debug, Clone)]

@@ -13,6 +13,7 @@ pub mod fit;
 pub mod lockin;
 pub mod model_file;
 pub mod output;
+pub mod reports;
 pub mod run_inputs;
 pub mod simulate;
 

@@ -1,9 +1,10 @@
 //! The lab's HTML reports: one self-contained file (inline CSS, inline SVG
 //! plots drawn by plotters, no scripts, nothing fetched), so it reads the
 //! same offline and in any browser. Every subcommand that writes a report
-//! builds it here (document.rs, plot.rs, text.rs); the commands write the
-//! file.
+//! builds it here (document.rs, plot.rs, text.rs, verdict.rs); the
+//! commands write the file.
 
 pub mod document;
 pub mod plot;
 pub mod text;
+pub mod verdict;

@@ -4,6 +4,8 @@
 
 use super::figures::{noise_floor_100s, std_of_means, std_se};
 use super::fit::{coefficient_se, fit_thermal, CubicModel, ThermalData};
+use super::warnings;
+use crate::calibration::warning::Warning;
 use gyro_sp::rlg::{CoeffError, ThermalCoeffs};
 
 /// The averaging of the drift figures, s.
@@ -23,6 +25,18 @@ pub struct FitSummary {
     /// Standard error of each standard deviation above (same order).
     pub std_100s_se_dph: [f64; 4],
     pub cubic: CubicModel,
+    /// Rows and run length, s; the ranges of the monoblock sensor A and
+    /// the case sensor, degC.
+    pub rows: usize,
+    pub duration_s: f64,
+    pub mono_a_range_c: [f64; 2],
+    pub case_range_c: [f64; 2],
+    pub warnings: Vec<Warning>,
+    /// The improved model's residual and the cubic's, per row, deg/h.
+    #[serde(skip)]
+    pub residual_dph: Vec<f64>,
+    #[serde(skip)]
+    pub cubic_residual_dph: Vec<f64>,
 }
 
 /// Why a chamber run gives no coefficients the firmware takes.
@@ -48,6 +62,14 @@ impl std::fmt::Display for ThermalFitError {
     }
 }
 
+/// Smallest and largest of `v`.
+pub fn range(v: &[f64]) -> [f64; 2] {
+    v.iter()
+        .fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| {
+            [a.min(*x), b.max(*x)]
+        })
+}
+
 /// The drift of a run after the classic cubic `m` on the sensor A.
 pub fn cubic_residual(m: &CubicModel, d: &ThermalData) -> Vec<f64> {
     d.drift_dph
@@ -70,15 +92,33 @@ pub fn calibrate(d: &ThermalData) -> Result<FitSummary, ThermalFitError> {
         std_of_means(&d.t, &cubic_res, WINDOW_S),
         noise_floor_100s(&d.t, &d.drift_dph),
     ];
+    let se = coefficient_se(d, &c);
+    let std_se_v = stds.map(|x| std_se(x, &d.t, WINDOW_S));
+    let mut warns = se
+        .as_ref()
+        .map_or_else(Vec::new, |e| warnings::unresolved_terms(d, &c, e));
+    warns.extend(warnings::residual(
+        stds[1],
+        std_se_v[1],
+        stds[3],
+        std_se_v[3],
+    ));
     Ok(FitSummary {
         coefficients: c,
-        coefficient_se: coefficient_se(d, &c),
+        coefficient_se: se,
         raw_std_100s_dph: stds[0],
         residual_std_100s_dph: stds[1],
         cubic_std_100s_dph: stds[2],
         noise_floor_100s_dph: stds[3],
-        std_100s_se_dph: stds.map(|x| std_se(x, &d.t, WINDOW_S)),
+        std_100s_se_dph: std_se_v,
         cubic,
+        rows: d.t.len(),
+        mono_a_range_c: range(&d.a),
+        case_range_c: range(&d.case),
+        duration_s: d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0),
+        warnings: warns,
+        residual_dph: resid,
+        cubic_residual_dph: cubic_res,
     })
 }
 
@@ -97,6 +137,12 @@ pub struct CompensateSummary {
     pub cubic_std_100s_dph: Option<f64>,
     pub coeffs_refused: bool,
     pub sensor_flags_seen: u8,
+    pub rows: usize,
+    pub duration_s: f64,
+    pub warnings: Vec<Warning>,
+    /// The compensated drift per row, deg/h.
+    #[serde(skip)]
+    pub comp_drift_dph: Vec<f64>,
 }
 
 /// The figures of a compensated run: `comp` its compensated rate (deg/s),
@@ -118,16 +164,44 @@ pub fn compensation_summary(
     let comp_std = std_of_means(&d.t, &comp_drift, WINDOW_S);
     let cubic_std = cubic.map(|m| std_of_means(&d.t, &cubic_residual(m, d), WINDOW_S));
     let raw_std = std_of_means(&d.t, &d.drift_dph, WINDOW_S);
+    let (comp_se, floor_se) = (
+        std_se(comp_std, &d.t, WINDOW_S),
+        std_se(floor, &d.t, WINDOW_S),
+    );
+    let refused = c.check().is_err();
+    let flags_seen = flags.iter().fold(0, |x, f| x | f);
+    let mut warns: Vec<Warning> = warnings::residual(comp_std, comp_se, floor, floor_se)
+        .into_iter()
+        .collect();
+    if refused {
+        warns.push(Warning::new(
+            "coeffs_refused",
+            "the firmware's check refused the coefficients: the run was not compensated".into(),
+        ));
+    }
+    if flags_seen != 0 {
+        warns.push(Warning::new(
+            "sensor_flagged",
+            format!(
+                "temperature sensor flags {flags_seen:#04x} were raised: a flagged sensor's last good \
+                 value was held"
+            ),
+        ));
+    }
     CompensateSummary {
         raw_std_100s_dph: raw_std,
         comp_std_100s_dph: comp_std,
         noise_floor_100s_dph: floor,
         raw_std_100s_se_dph: std_se(raw_std, &d.t, WINDOW_S),
-        comp_std_100s_se_dph: std_se(comp_std, &d.t, WINDOW_S),
-        noise_floor_100s_se_dph: std_se(floor, &d.t, WINDOW_S),
+        comp_std_100s_se_dph: comp_se,
+        noise_floor_100s_se_dph: floor_se,
         comp_over_floor: comp_std / floor,
         cubic_std_100s_dph: cubic_std,
-        coeffs_refused: c.check().is_err(),
-        sensor_flags_seen: flags.iter().fold(0, |x, f| x | f),
+        coeffs_refused: refused,
+        sensor_flags_seen: flags_seen,
+        rows: d.t.len(),
+        duration_s: d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0),
+        warnings: warns,
+        comp_drift_dph: comp_drift,
     }
 }
