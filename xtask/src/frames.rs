@@ -129,13 +129,28 @@ pub fn write_reference(path: &Path) -> Result<RateLog> {
         writeln!(w, "{t:.6},{r:.12}")?;
     }
     w.flush()?;
+    drop(w);
+    // Read back as `gyro-lab record --reference` reads it, so both paths
+    // hold the very same numbers.
+    let text = std::fs::read_to_string(path)?;
+    let (mut t, mut r) = (vec![], vec![]);
+    for line in text.lines().skip(2) {
+        let (a, b) = line.split_once(',').context("reference row")?;
+        t.push(a.parse()?);
+        r.push(b.parse()?);
+    }
     RateLog::new(t, r, 0.0).map_err(|e| anyhow::anyhow!("reference log: {e:?}"))
 }
 
 /// The run files of a capture, through the recorder `gyro-lab record`
 /// uses (same decoder, same rows): `dir/fog.csv`, `dir/rlg.csv` and
 /// `dir/raw.bin`.
-pub fn record_capture(capture: &Path, dir: &Path, reference: RateLog) -> Result<Summary> {
+/// Also returns the FOG angle (deg) and RLG counts over the record.
+pub fn record_capture(
+    capture: &Path,
+    dir: &Path,
+    reference: RateLog,
+) -> Result<(Summary, (f64, i64))> {
     let bytes = std::fs::read(capture).with_context(|| format!("reading {}", capture.display()))?;
     let cfg = FogConfig::new(FogParams::default()).map_err(|e| anyhow::anyhow!("{e:?}"))?;
     let scales = Scales::new(&cfg, ChamberParams::default().counts_per_deg);
@@ -147,7 +162,9 @@ pub fn record_capture(capture: &Path, dir: &Path, reference: RateLog) -> Result<
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     rec.push(&bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
-    rec.finish().map_err(|e| anyhow::anyhow!("{e}"))
+    let angles = rec.angles();
+    let summary = rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok((summary, angles))
 }
 
 /// Per segment, after 20 ms settling: mean and RMS of the final output

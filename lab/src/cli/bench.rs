@@ -31,6 +31,8 @@ pub enum BenchCmd {
     AllanSpeed(SpeedArgs),
     /// Discovery on randomized runs with hidden effects: the confusion table.
     Discover(DiscoverBenchArgs),
+    /// The recorder on a ten-minute capture: the CPU it needs at the board's rate.
+    Record(crate::cli::bench_record::RecordBenchArgs),
 }
 
 pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
@@ -40,6 +42,7 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::Allan(a) => allan(a),
         BenchCmd::AllanSpeed(a) => allan_speed(a),
         BenchCmd::Discover(a) => discover(a),
+        BenchCmd::Record(a) => crate::cli::bench_record::run(a),
     }
 }
 

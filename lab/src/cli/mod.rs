@@ -7,12 +7,14 @@ pub mod adev_plot;
 pub mod allan;
 pub mod args;
 pub mod bench;
+pub mod bench_record;
 pub mod compensate;
 pub mod discover;
 pub mod fit;
 pub mod lockin;
 pub mod model_file;
 pub mod output;
+pub mod record;
 pub mod reports;
 pub mod run_inputs;
 pub mod simulate;
@@ -48,6 +50,8 @@ pub enum Cmd {
     Discover(discover::DiscoverArgs),
     /// Apply a coefficient file as the firmware does; adds `rate_comp_dps`.
     Compensate(compensate::CompensateArgs),
+    /// The board's frames from a serial port (or a raw capture) into run files.
+    Record(record::RecordArgs),
     /// Benchmarks of the estimators on simulated records.
     #[command(subcommand)]
     Bench(bench::BenchCmd),
@@ -71,6 +75,7 @@ pub fn run(cli: &Cli) -> Result<(), LabError> {
         Cmd::Compensate(a) => compensate::run(a),
         Cmd::Allan(a) => allan::run(a),
         Cmd::Discover(a) => discover::run(a),
+        Cmd::Record(a) => record::run(a),
         Cmd::Bench(c) => bench::run(c),
     }
 }

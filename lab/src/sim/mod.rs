@@ -2,8 +2,10 @@
 //! FOG core closed around the simulated optics (fog_run.rs), an RLG in a
 //! thermal chamber (chamber.rs), the FOG scale-factor rig (scale_factor_rig.rs),
 //! RLG fringes near lock-in (fringe.rs), a gyro model with the project's
-//! noise (model_run.rs) and records of known noise terms (noise_run.rs).
+//! noise (model_run.rs), records of known noise terms (noise_run.rs) and
+//! the byte stream a board sends (board_stream.rs).
 
+pub mod board_stream;
 pub mod chamber;
 pub mod fog_run;
 pub mod fringe;
