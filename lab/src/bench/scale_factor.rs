@@ -12,8 +12,9 @@
 //!
 //! The model families: five coils (a knee on a straight line, a straight
 //! line, a quadratic, a cubic, a knee on the quadratic's curved
-//! background), each fitted on the same cycle and validated on the steps
-//! profile at -100 deg/s: the family and degree chosen against the truth's,
+//! background), each fitted on the issue's run (the same cycle at +-100
+//! deg/s, 0.01 deg/sqrt(h)) and validated on the steps profile at -100
+//! deg/s: the family and degree chosen against the truth's,
 //! the knees, the curvature with its interval, the validation RMS.
 
 use crate::calibration::scale_factor::compensation::compensate_rows;
@@ -66,6 +67,20 @@ pub fn continuous_fit_test() -> Test {
         reverse_every_s: 300.0,
     }
 }
+
+/// The families' fit run (issue 25): the cycle at +-100 deg/s reversed
+/// every 5 min, with [`FAMILIES_ARW_DPSH`].
+pub fn families_fit_test() -> Test {
+    Test::Continuous {
+        profile: SweepProfile::Cycle,
+        rate_dps: 100.0,
+        direction: Direction::Both,
+        reverse_every_s: 300.0,
+    }
+}
+
+/// Angle random walk of the families' runs, deg/sqrt(h).
+pub const FAMILIES_ARW_DPSH: f64 = 0.01;
 
 pub fn validation_test() -> Test {
     Test::Continuous {
@@ -204,6 +219,8 @@ pub struct FamilyRow {
     /// Table nodes and the firmware lookup's largest departure from the
     /// fitted model, ppm.
     pub table_nodes: Stats,
+    /// The closest node spacing of each seed's table, degC.
+    pub table_spacing_c: Stats,
     pub tabulation_ppm: Stats,
     /// Validation RMS of 60 s means through the firmware, ppm.
     pub validation_ppm: Stats,
@@ -239,6 +256,7 @@ struct Gather {
     curv: Vec<f64>,
     curv_covers: usize,
     nodes: Vec<f64>,
+    spacing: Vec<f64>,
     tab: Vec<f64>,
     val: Vec<f64>,
 }
@@ -279,6 +297,8 @@ impl Gather {
             }
         }
         self.nodes.push(f.tabulation.nodes as f64);
+        let closest = f.tabulation.spacing_c.iter().fold(f64::INFINITY, |a, &h| a.min(h));
+        self.spacing.push(closest);
         self.tab.push(f.tabulation.max_error_ppm);
         self.val.push(val_ppm);
     }
@@ -299,6 +319,7 @@ impl Gather {
             curvature: stats(&self.curv),
             curvature_ci_covers: self.curv_covers,
             table_nodes: stats(&self.nodes),
+            table_spacing_c: stats(&self.spacing),
             tabulation_ppm: stats(&self.tab),
             validation_ppm: stats(&self.val),
         }
@@ -362,9 +383,10 @@ pub fn run(seeds: u64, mut progress: impl FnMut()) -> Result<ScaleFactorBench, B
         for (j, (coil, g)) in coils.iter().zip(&mut gathered).enumerate() {
             let p = RigParams {
                 truth: coil.truth,
+                arw_dpsh: FAMILIES_ARW_DPSH,
                 ..rig(seed + 40_000 + 1_000 * j as u64)
             };
-            let (f, _) = fit(&input(&simulate(&continuous_fit_test(), &p)))
+            let (f, _) = fit(&input(&simulate(&families_fit_test(), &p)))
                 .map_err(|e| fail(BenchRun::Family(coil.name), e))?;
             let v = simulate(
                 &validation_test(),

@@ -179,19 +179,19 @@ fn print_families(j: &ScaleFactorBench) {
     let n = j.seeds;
     println!();
     println!(
-        "model families (fit: cycle, +-50 deg/s; validation: steps, -100 deg/s; RMS of 60 s means)"
+        "model families (fit: cycle -40..+60 degC, +-100 deg/s, 0.01 deg/sqrt(h); validation: steps, -100 deg/s; RMS of 60 s means)"
     );
-    println!(
-        "{:<26} {:<26} {:>9} {:>14} {:>16} {:>22} {:>12} {:>16}",
+    let head = [
         "coil",
-        "expected model",
+        "expected",
         "right",
         "chosen K/P/PK",
-        "knee err degC",
-        "curvature (95 % cov.)",
-        "table nodes",
-        "validation ppm"
-    );
+        "knee err degC mean/max (CI covers)",
+        "top coefficient mean vs truth (CI covers)",
+        "table nodes / spacing degC / max err ppm",
+        "validation ppm mean +- sd (max)",
+    ];
+    let mut rows: Vec<Vec<String>> = vec![head.iter().map(|h| h.to_string()).collect()];
     for r in &j.families {
         let knee = if r.knee_abs_err_c.n > 0 {
             format!(
@@ -203,29 +203,46 @@ fn print_families(j: &ScaleFactorBench) {
         };
         let curv = if r.curvature.n > 0 {
             format!(
-                "{:.2e} vs {:.2e} ({}/{})",
+                "{:.3e} vs {:.1e} ({}/{})",
                 r.curvature.mean, r.curvature_truth, r.curvature_ci_covers, r.curvature.n
             )
         } else {
             "-".into()
         };
-        println!(
-            "{:<26} {:<26} {:>9} {:>14} {:>16} {:>22} {:>12} {:>16}",
-            r.coil,
-            format!("{} degree {}", r.expected_model, r.expected_degree),
+        rows.push(vec![
+            r.coil.to_string(),
+            format!("{} {}", r.expected_model, r.expected_degree),
             format!("{}/{n}", r.right_model),
             format!("{}/{}/{}", r.chosen[0], r.chosen[1], r.chosen[2]),
             knee,
             curv,
             format!(
-                "{:.0} ({:.3} ppm)",
-                r.table_nodes.mean, r.tabulation_ppm.max
+                "{:.0} / {:.2} / {:.3}",
+                r.table_nodes.mean, r.table_spacing_c.mean, r.tabulation_ppm.max
             ),
             format!(
-                "{:.3} +- {:.3} (max {:.3})",
+                "{:.3} +- {:.3} ({:.3})",
                 r.validation_ppm.mean, r.validation_ppm.sd, r.validation_ppm.max
             ),
-        );
+        ]);
+    }
+    let widths: Vec<usize> = (0..head.len())
+        .map(|c| rows.iter().map(|r| r[c].len()).max().unwrap_or(0))
+        .collect();
+    for r in &rows {
+        let cells: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (x, &w))| {
+                if c < 2 {
+                    format!("{x:<w$}")
+                } else {
+                    format!("{x:>w$}")
+                }
+            })
+            .collect();
+        println!("{}", cells.join("  "));
     }
 }
 
