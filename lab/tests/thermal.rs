@@ -210,4 +210,31 @@ fn reports_and_their_warnings() {
         "{kinds:?}"
     );
     report_check::check(&html, &v, 4, 12);
+    // The soak's coefficients on the cycle: the run leaves the one
+    // temperature the fit saw, and the compensation report says where.
+    std::fs::create_dir_all(d.join("sc")).unwrap();
+    let v = lab_json(&[
+        "compensate",
+        "--coeffs",
+        &p("s/c.toml"),
+        "--data",
+        &p("fit.csv"),
+        "--out",
+        &p("sc/comp.csv"),
+    ]);
+    let html = std::fs::read_to_string(d.join("sc").join("report.html")).unwrap();
+    report_check::check(&html, &v, 2, 8);
+    let kinds = report_check::assert_warnings_match(&html, &v);
+    assert!(
+        kinds.iter().any(|k| k == "outside_calibrated_range"),
+        "{kinds:?}"
+    );
+    let spans = v["out_of_range_spans"].as_array().unwrap();
+    let [lo, hi] = [0, 1].map(|i| v["calibrated_range"]["mono_a_c"][i].as_f64().unwrap());
+    assert!(!spans.is_empty(), "{v}");
+    for s in spans {
+        let (a, b) = (s["min_c"].as_f64().unwrap(), s["max_c"].as_f64().unwrap());
+        assert!(a < lo || b > hi, "{s} inside {lo} .. {hi}");
+    }
+    assert!(html.contains("outside the fit&#39;s temperatures") || html.contains("outside the fit's temperatures"));
 }

@@ -5,7 +5,9 @@
 use crate::calibration::scale_factor::validation::{validate, Validation};
 use crate::calibration::thermal::compensation::compensate;
 use crate::calibration::thermal::fit::CubicModel;
-use crate::calibration::thermal::summary::{compensation_summary, CompensateSummary};
+use crate::calibration::thermal::summary::{
+    compensation_summary, CalibratedRange, CompensateSummary,
+};
 use crate::cli::args::{Json, NoReport, Out};
 use crate::cli::output::{print_json, write_report};
 use crate::cli::reports;
@@ -45,15 +47,33 @@ struct ThermalJson<'a> {
 }
 
 pub fn run(a: &CompensateArgs) -> Result<(), LabError> {
-    let (_, coeffs) =
+    let (file, coeffs) =
         gyro_coeffs::file::read(&a.coeffs).map_err(|e| LabError::coeffs_input(&a.coeffs, &e))?;
     match coeffs {
-        Coeffs::RlgThermal(c) => rlg_thermal(a, &c),
+        Coeffs::RlgThermal(c) => rlg_thermal(a, &c, file.fit.as_ref().and_then(thermal_range)),
         Coeffs::FogScaleFactor(t) => fog_scale_factor(a, &t),
     }
 }
 
-fn rlg_thermal(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
+/// The temperatures a thermal fit saw, from its file's `[fit]` table
+/// (files written before they were kept there have none).
+fn thermal_range(fit: &toml::Table) -> Option<CalibratedRange> {
+    let pair = |k: &str| -> Option<[f64; 2]> {
+        let v = fit.get(k)?.as_array()?;
+        let f = |i: usize| v.get(i).and_then(|x| x.as_float().or(x.as_integer().map(|n| n as f64)));
+        Some([f(0)?, f(1)?])
+    };
+    Some(CalibratedRange {
+        mono_a_c: pair("mono_a_range_c")?,
+        case_c: pair("case_range_c")?,
+    })
+}
+
+fn rlg_thermal(
+    a: &CompensateArgs,
+    c: &ThermalCoeffs,
+    range: Option<CalibratedRange>,
+) -> Result<(), LabError> {
     let (text, d) = thermal_run(&a.data)?;
     let (comp, flags) = compensate(c, &d, &text.run.rate_dps);
     text.write_back(&a.out.out, &[(Column::CompensatedRate, &comp)])?;
@@ -73,6 +93,7 @@ fn rlg_thermal(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
         &text.run.ref_rate_dps,
         (&comp, &flags),
         cubic.as_ref(),
+        range,
     );
     let report = (!a.no_report.no_report).then(|| reports::beside(&a.out.out));
     if let Some(path) = &report {

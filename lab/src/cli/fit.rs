@@ -52,6 +52,12 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
     ] {
         info.insert(k.into(), v.into());
     }
+    for (k, [lo, hi]) in [
+        ("mono_a_range_c", s.mono_a_range_c),
+        ("case_range_c", s.case_range_c),
+    ] {
+        info.insert(k.into(), toml::Value::Array(vec![lo.into(), hi.into()]));
+    }
     info.insert(
         "record_crc32".into(),
         format!("0x{:08x}", gyro_coeffs::record::crc_of(&c.to_record())).into(),

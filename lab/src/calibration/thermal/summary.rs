@@ -5,6 +5,7 @@
 use super::figures::{noise_floor_100s, std_of_means, std_se};
 use super::fit::{coefficient_se, fit_thermal, CubicModel, ThermalData};
 use super::warnings;
+use crate::calibration::scale_factor::validation::{flag_spans, FlagSpan};
 use crate::calibration::warning::Warning;
 use gyro_sp::rlg::{CoeffError, ThermalCoeffs};
 
@@ -122,6 +123,17 @@ pub fn calibrate(d: &ThermalData) -> Result<FitSummary, ThermalFitError> {
     })
 }
 
+/// The temperatures a thermal fit saw (its coefficient file's `[fit]`
+/// table keeps them): monoblock sensor A and the case sensor, degC.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct CalibratedRange {
+    pub mono_a_c: [f64; 2],
+    pub case_c: [f64; 2],
+}
+
+/// A run this far outside the calibrated range is warned about, degC.
+pub const OUT_OF_RANGE_MARGIN_C: f64 = 0.5;
+
 #[derive(Debug, serde::Serialize)]
 pub struct CompensateSummary {
     pub raw_std_100s_dph: f64,
@@ -139,21 +151,63 @@ pub struct CompensateSummary {
     pub sensor_flags_seen: u8,
     pub rows: usize,
     pub duration_s: f64,
+    /// The fit's temperatures (null when the coefficient file does not
+    /// state them) and the spans of this run outside them by more than
+    /// [`OUT_OF_RANGE_MARGIN_C`] (`min_c`, `max_c`: monoblock sensor A).
+    pub calibrated_range: Option<CalibratedRange>,
+    pub out_of_range_spans: Vec<FlagSpan>,
     pub warnings: Vec<Warning>,
     /// The compensated drift per row, deg/h.
     #[serde(skip)]
     pub comp_drift_dph: Vec<f64>,
 }
 
+/// The rows' spans outside `r` (by more than the margin) on either sensor.
+fn outside(d: &ThermalData, r: &CalibratedRange) -> Vec<FlagSpan> {
+    let out = |x: f64, [lo, hi]: [f64; 2]| {
+        x < lo - OUT_OF_RANGE_MARGIN_C || x > hi + OUT_OF_RANGE_MARGIN_C
+    };
+    let flags: Vec<u8> =
+        d.a.iter()
+            .zip(&d.case)
+            .map(|(&a, &k)| u8::from(out(a, r.mono_a_c) || out(k, r.case_c)))
+            .collect();
+    flag_spans(&d.t, &flags, 1, &d.a)
+}
+
+fn outside_warning(spans: &[FlagSpan], r: &CalibratedRange) -> Option<Warning> {
+    if spans.is_empty() {
+        return None;
+    }
+    let secs: f64 = spans.iter().map(|s| s.to_s - s.from_s).sum();
+    let (lo, hi) = spans
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
+            (a.min(s.min_c), b.max(s.max_c))
+        });
+    Some(Warning::new(
+        "outside_calibrated_range",
+        format!(
+            "{secs:.0} s of the run in {} span(s) lay outside the temperatures the fit saw              (monoblock A {:.1} .. {:.1} degC, case {:.1} .. {:.1} degC; here monoblock A {lo:.1} ..              {hi:.1} degC): the model is extrapolated there",
+            spans.len(),
+            r.mono_a_c[0],
+            r.mono_a_c[1],
+            r.case_c[0],
+            r.case_c[1]
+        ),
+    ))
+}
+
 /// The figures of a compensated run: `comp` its compensated rate (deg/s),
 /// `flags` the sensor flags of each row, `cubic` a classic cubic fitted on
-/// another run (for comparison only).
+/// another run (for comparison only), `range` the temperatures the fit saw.
 pub fn compensation_summary(
     c: &ThermalCoeffs,
     d: &ThermalData,
     ref_rate_dps: &[f64],
     (comp, flags): (&[f64], &[u8]),
     cubic: Option<&CubicModel>,
+    range: Option<CalibratedRange>,
 ) -> CompensateSummary {
     let comp_drift: Vec<f64> = comp
         .iter()
@@ -179,6 +233,10 @@ pub fn compensation_summary(
             "the firmware's check refused the coefficients: the run was not compensated".into(),
         ));
     }
+    let spans = range.as_ref().map_or_else(Vec::new, |r| outside(d, r));
+    if let Some(r) = &range {
+        warns.extend(outside_warning(&spans, r));
+    }
     if flags_seen != 0 {
         warns.push(Warning::new(
             "sensor_flagged",
@@ -201,6 +259,8 @@ pub fn compensation_summary(
         sensor_flags_seen: flags_seen,
         rows: d.t.len(),
         duration_s: d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0),
+        calibrated_range: range,
+        out_of_range_spans: spans,
         warnings: warns,
         comp_drift_dph: comp_drift,
     }

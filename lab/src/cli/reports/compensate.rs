@@ -240,6 +240,15 @@ fn th_verdict((coeffs, data): &(String, String), s: &CompensateSummary) -> Verdi
             .text(" deg/h)");
     }
     v.text(".");
+    if let Some(range) = &s.calibrated_range {
+        v.text(" The fit saw monoblock A ")
+            .num("calibrated_range.mono_a_c.0", range.mono_a_c[0], 1)
+            .text(" .. ")
+            .num("calibrated_range.mono_a_c.1", range.mono_a_c[1], 1)
+            .text(" degC; ")
+            .count("out_of_range_spans.length", s.out_of_range_spans.len())
+            .text(" span(s) of this run lay outside it.");
+    }
     warnings(&mut v, &s.warnings);
     v
 }
@@ -249,13 +258,25 @@ pub fn thermal(names: &(String, String), d: &ThermalData, s: &CompensateSummary)
     let mut r = Report::new(&format!("RLG thermal compensation: {}", names.1));
     r.verdict(&th_verdict(names, s));
     r.heading("Before and after");
+    let mut series = vec![
+        Series::line("before", means_over_time(&d.t, &d.drift_dph), 7),
+        Series::line("after", means_over_time(&d.t, &s.comp_drift_dph), 0),
+    ];
+    if !s.out_of_range_spans.is_empty() {
+        series.push(Series::bands(
+            "outside the fit's temperatures",
+            s.out_of_range_spans
+                .iter()
+                .map(|x| (x.from_s / 3600.0, x.to_s / 3600.0))
+                .collect(),
+            1,
+        ));
+    }
     r.plot(
         &Axes::linear("Drift against time, 100 s means", "time, h", "drift, deg/h"),
-        &[
-            Series::line("before", means_over_time(&d.t, &d.drift_dph), 7),
-            Series::line("after", means_over_time(&d.t, &s.comp_drift_dph), 0),
-        ],
-        "Output minus the reference rate before and after the firmware's compensation, 100 s means.",
+        &series,
+        "Output minus the reference rate before and after the firmware's compensation, 100 s means; \
+         shaded, any span where the run left the temperatures the fit saw (the model extrapolated).",
     );
     let ta = window_means(&d.t, &d.a, WINDOW_S);
     let before = window_means(&d.t, &d.drift_dph, WINDOW_S);
@@ -293,5 +314,35 @@ pub fn thermal(names: &(String, String), d: &ThermalData, s: &CompensateSummary)
             ],
         ],
     );
+    match &s.calibrated_range {
+        None => r.paragraph(
+            "The coefficient file does not state the temperatures its fit saw (written before they were \
+             kept): no check of the calibrated range.",
+        ),
+        Some(_) if s.out_of_range_spans.is_empty() => {
+            r.paragraph("The run stayed inside the temperatures the fit saw.")
+        }
+        Some(_) => {
+            let rows: Vec<Vec<String>> = s
+                .out_of_range_spans
+                .iter()
+                .map(|x| {
+                    vec![
+                        format!("{:.0}", x.from_s),
+                        format!("{:.0}", x.to_s),
+                        format!("{:.2} .. {:.2}", x.min_c, x.max_c),
+                    ]
+                })
+                .collect();
+            r.table(
+                &[
+                    "outside the fit's temperatures: from, s",
+                    "to, s",
+                    "monoblock A, degC",
+                ],
+                &rows,
+            )
+        }
+    }
     r
 }
