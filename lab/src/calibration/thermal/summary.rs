@@ -188,7 +188,9 @@ fn outside_warning(spans: &[FlagSpan], r: &CalibratedRange) -> Option<Warning> {
     Some(Warning::new(
         "outside_calibrated_range",
         format!(
-            "{secs:.0} s of the run in {} span(s) lay outside the temperatures the fit saw              (monoblock A {:.1} .. {:.1} degC, case {:.1} .. {:.1} degC; here monoblock A {lo:.1} ..              {hi:.1} degC): the model is extrapolated there",
+            "{secs:.0} s of the run in {} span(s) lay outside the temperatures the fit saw \
+             (monoblock A {:.1} .. {:.1} degC, case {:.1} .. {:.1} degC; here monoblock A {lo:.1} .. \
+             {hi:.1} degC): the model is extrapolated there",
             spans.len(),
             r.mono_a_c[0],
             r.mono_a_c[1],
