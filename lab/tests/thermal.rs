@@ -236,5 +236,8 @@ fn reports_and_their_warnings() {
         let (a, b) = (s["min_c"].as_f64().unwrap(), s["max_c"].as_f64().unwrap());
         assert!(a < lo || b > hi, "{s} inside {lo} .. {hi}");
     }
-    assert!(html.contains("outside the fit&#39;s temperatures") || html.contains("outside the fit's temperatures"));
+    assert!(
+        html.contains("outside the fit&#39;s temperatures")
+            || html.contains("outside the fit's temperatures")
+    );
 }

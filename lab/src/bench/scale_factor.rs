@@ -297,7 +297,11 @@ impl Gather {
             }
         }
         self.nodes.push(f.tabulation.nodes as f64);
-        let closest = f.tabulation.spacing_c.iter().fold(f64::INFINITY, |a, &h| a.min(h));
+        let closest = f
+            .tabulation
+            .spacing_c
+            .iter()
+            .fold(f64::INFINITY, |a, &h| a.min(h));
         self.spacing.push(closest);
         self.tab.push(f.tabulation.max_error_ppm);
         self.val.push(val_ppm);

@@ -60,7 +60,10 @@ pub fn run(a: &CompensateArgs) -> Result<(), LabError> {
 fn thermal_range(fit: &toml::Table) -> Option<CalibratedRange> {
     let pair = |k: &str| -> Option<[f64; 2]> {
         let v = fit.get(k)?.as_array()?;
-        let f = |i: usize| v.get(i).and_then(|x| x.as_float().or(x.as_integer().map(|n| n as f64)));
+        let f = |i: usize| {
+            v.get(i)
+                .and_then(|x| x.as_float().or(x.as_integer().map(|n| n as f64)))
+        };
         Some([f(0)?, f(1)?])
     };
     Some(CalibratedRange {

@@ -6,7 +6,8 @@ use super::text::esc;
 use super::verdict::Verdict;
 use std::fmt::Write as _;
 
-const CSS: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
+const CSS: &str =
+    "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}\
 table{border-collapse:collapse;margin:0.8em 0}td,th{border:1px solid #bbb;padding:3px 8px;\
 text-align:right}th{background:#eee}td:first-child,th:first-child{text-align:left}\
