@@ -108,7 +108,7 @@ pub fn verdict(html: &str) -> String {
 }
 
 /// The value at a JSON path `a.b.0` (`.length`: an array's length).
-fn at<'a>(v: &'a serde_json::Value, path: &str) -> serde_json::Value {
+fn at(v: &serde_json::Value, path: &str) -> serde_json::Value {
     let mut cur = v.clone();
     for seg in path.split('.') {
         cur = match (seg, &cur) {

@@ -118,7 +118,7 @@ pub fn diagnostics(inp: &SfInput, fit: &SfFit) -> SfDiagnostics {
     let width = 1.5 * fit.sensor_lag_s.map_or(1.0, |l| (l.hi - l.lo).max(0.5));
     let sf = |t: f64| c.map_or_else(|| fit.table.eval(t).0, |c| c.sf_ppm(t));
     let bias = |t: f64| c.map_or_else(|| fit.table.eval(t).1 / 3600.0, |c| c.bias_dps(t));
-    let with_bias = c.map_or(true, |c| c.bias.is_some());
+    let with_bias = c.is_none_or(|c| c.bias.is_some());
     let rows: Vec<usize> = if with_bias {
         (0..inp.t.len()).collect()
     } else {

@@ -65,7 +65,8 @@ pub fn unresolved_terms(d: &ThermalData, c: &ThermalCoeffs, se: &ThermalCoeffs) 
     ];
     terms
         .iter()
-        .filter(|t| !(t.1.abs() > 1.96 * t.2))
+        // Not resolved: the interval holds 0, or the figures are not numbers.
+        .filter(|t| t.1.abs().partial_cmp(&(1.96 * t.2)) != Some(std::cmp::Ordering::Greater))
         .map(|&(name, v, e, s, why)| {
             let s = if s.abs() >= 1e-3 && s.abs() < 1e4 {
                 format!("{s:.3}")

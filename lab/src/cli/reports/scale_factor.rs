@@ -376,10 +376,8 @@ fn lag_plots(r: &mut Report, f: &SfFit, d: &SfDiagnostics) {
             "coil estimate - sensor, degC",
         ),
         &[Series::line("lag x d(sensor)/dt", lead, 1)],
-        &format!(
-            "How far the coil runs ahead of its sensor by the fitted lag: the lag times the sensor's \
-             filtered rate of change, as the firmware forms it (zero on soaks, lag x ramp rate on ramps)."
-        ),
+        "How far the coil runs ahead of its sensor by the fitted lag: the lag times the sensor's \
+         filtered rate of change, as the firmware forms it (zero on soaks, lag x ramp rate on ramps).",
     );
     r.plot(
         &Axes::linear("Coil sensor", "time, h", "temperature, degC"),
