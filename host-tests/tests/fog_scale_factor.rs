@@ -2,6 +2,7 @@
 //! its floating-point model (`ScaleFactorTable::eval`), the coil-sensor lead
 //! against a simulated lagging sensor, and the fault paths.
 
+use gyro_coeffs::fog_scale_factor::MAX_NODES;
 use gyro_sim::CoilThermal;
 use gyro_sp::fog::scale_factor::{
     FogTempFlags, ScaleFactorComp, ScaleFactorConfig, ScaleFactorTable, LEAD_FILTER_TAU_S,
@@ -168,7 +169,11 @@ fn refused_table_compensates_nothing_and_flags() {
     // Out of order nodes, too many nodes, values beyond the fixed-point range.
     for bad in [
         ScaleFactorTable::from_nodes(&[10.0, 0.0], &[0.0, 0.0], &[0.0, 0.0], 0.0),
-        ScaleFactorTable::from_nodes(&[0.0; 9], &[0.0; 9], &[0.0; 9], 0.0),
+        {
+            let too_many: Vec<f64> = (0..=MAX_NODES).map(|k| k as f64).collect();
+            let zeros = vec![0.0; MAX_NODES + 1];
+            ScaleFactorTable::from_nodes(&too_many, &zeros, &zeros, 0.0)
+        },
         ScaleFactorTable::from_nodes(&[0.0, 10.0], &[30_000.0, 0.0], &[0.0, 0.0], 0.0),
         ScaleFactorTable::from_nodes(&[0.0, 10.0], &[0.0, 0.0], &[f64::NAN, 0.0], 0.0),
     ] {
@@ -197,14 +202,17 @@ proptest! {
     #[test]
     fn lookup_follows_the_model(
         t0 in -55.0f64..0.0,
-        gaps in proptest::collection::vec(0.5f64..40.0, 1..7),
-        sf in proptest::collection::vec(-20_000.0f64..20_000.0, 8),
-        bias in proptest::collection::vec(-1_000.0f64..1_000.0, 8),
+        gaps in proptest::collection::vec(0.0f64..1.0, 1..MAX_NODES),
+        spread in 1.0f64..40.0,
+        sf in proptest::collection::vec(-20_000.0f64..20_000.0, MAX_NODES),
+        bias in proptest::collection::vec(-1_000.0f64..1_000.0, MAX_NODES),
         t_q8 in -60 * 256i32..160 * 256,
     ) {
         let mut temps = vec![t0];
+        // Gaps from 0.5 degC to 40 degC; with a small spread, tables of up
+        // to the 64 nodes a tabulated polynomial takes.
         for g in &gaps {
-            let next = temps[temps.len() - 1] + g;
+            let next = temps[temps.len() - 1] + 0.5 + g * spread;
             if next > 150.0 { break; }
             temps.push(next);
         }

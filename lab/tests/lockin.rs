@@ -106,3 +106,139 @@ fn locked_in_gives_no_beat() {
     let f = p.simulate();
     assert!(lock_in(&f.t, &f.s, None, p.pulses_per_deg, None).is_err());
 }
+
+mod common;
+mod report_check;
+
+/// `lockin --out DIR` writes a self-contained report: the record with its
+/// fit, the harmonics, the estimate against the Cramer-Rao bound; the
+/// verdict's numbers are the JSON's. A record whose information cannot
+/// reach 0.5 % (Omega_I/Omega_L = 100, one channel, 1 % noise: the bound
+/// is 1.15 %) is warned about, and so is a record holding a tone the
+/// lock-in equation does not make.
+#[test]
+fn report_with_the_fit_and_the_bound() {
+    let d = common::dir("lockin-report");
+    let p = |n: &str| d.join(n).display().to_string();
+    let (code, _, err) = common::lab(&[
+        "simulate",
+        "lockin",
+        "--rate-dps",
+        "1",
+        "--lock-in-dps",
+        "0.05",
+        "--noise",
+        "0.01",
+        "--quadrature",
+        "--out",
+        &p("f.csv"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = common::lab(&[
+        "lockin",
+        "--data",
+        &p("f.csv"),
+        "--pulses-per-deg",
+        "2000",
+        "--out",
+        &p("r"),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = common::json(&out);
+    let html = std::fs::read_to_string(d.join("r").join("report.html")).unwrap();
+    report_check::check(&html, &v, 3, 12);
+    assert!(v["warnings"].as_array().unwrap().is_empty(), "{v}");
+    // The bound is the physics.md formula for this record, and the fit
+    // reaches it (within 20 %: the fit's own covariance is the record's
+    // Fisher information).
+    let (crb, rel) = (
+        v["cramer_rao_rel"].as_f64().unwrap(),
+        v["lock_in_rel_std"].as_f64().unwrap(),
+    );
+    let rho = v["harmonic_ratio"].as_f64().unwrap();
+    let n = v["samples"].as_f64().unwrap();
+    let f0 = &v["channel_fits"][0];
+    let want =
+        f0["residual_rms"].as_f64().unwrap() / f0["amplitude"].as_f64().unwrap() / (n.sqrt() * rho);
+    assert!((crb / want - 1.0).abs() < 0.05, "{crb} vs {want}");
+    assert!((rel / crb - 1.0).abs() < 0.2, "{rel} vs {crb}");
+    // The residual is the noise: 1 % of the unit amplitude.
+    let noise = v["noise_rms"].as_f64().unwrap();
+    assert!((noise / 0.01 - 1.0).abs() < 0.05, "{noise}");
+
+    // Omega_I/Omega_L = 100 from one channel: the bound is above 0.5 %.
+    let (code, _, err) = common::lab(&[
+        "simulate",
+        "lockin",
+        "--rate-dps",
+        "1",
+        "--lock-in-dps",
+        "0.01",
+        "--noise",
+        "0.01",
+        "--out",
+        &p("g.csv"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = common::lab(&[
+        "lockin",
+        "--data",
+        &p("g.csv"),
+        "--pulses-per-deg",
+        "2000",
+        "--out",
+        &p("s"),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = common::json(&out);
+    let html = std::fs::read_to_string(d.join("s").join("report.html")).unwrap();
+    let kinds = report_check::assert_warnings_match(&html, &v);
+    assert!(kinds.iter().any(|k| k == "record_too_short"), "{kinds:?}");
+    report_check::check(&html, &v, 3, 12);
+
+    // A tone at 1.37 beat frequencies, 3 % of the fringe, added to the
+    // record: the residual stands above the noise under it.
+    let text = std::fs::read_to_string(d.join("f.csv")).unwrap();
+    let beat = 2000.0 * (1.0f64 - 0.05f64 * 0.05).sqrt();
+    let mut lines = text.lines();
+    let mut out_text = String::new();
+    let mut header_seen = false;
+    for l in lines.by_ref() {
+        out_text.push_str(l);
+        out_text.push('\n');
+        if !l.starts_with('#') {
+            header_seen = true;
+            break;
+        }
+    }
+    assert!(header_seen);
+    for l in lines {
+        let mut cells: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+        let tone = 0.03 * (std::f64::consts::TAU * 1.37 * beat * cells[0]).sin();
+        cells[1] += tone;
+        let row: Vec<String> = cells.iter().map(|c| format!("{c:e}")).collect();
+        out_text.push_str(&row.join(","));
+        out_text.push('\n');
+    }
+    std::fs::write(d.join("tone.csv"), out_text).unwrap();
+    let (code, out, err) = common::lab(&[
+        "lockin",
+        "--data",
+        &p("tone.csv"),
+        "--pulses-per-deg",
+        "2000",
+        "--out",
+        &p("t"),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v = common::json(&out);
+    let html = std::fs::read_to_string(d.join("t").join("report.html")).unwrap();
+    let kinds = report_check::assert_warnings_match(&html, &v);
+    assert!(
+        kinds.iter().any(|k| k == "residual_above_noise"),
+        "{kinds:?}"
+    );
+}

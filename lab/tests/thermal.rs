@@ -137,3 +137,107 @@ fn bad_coefficient_file() {
     assert!(err.contains(&format!("{}:5:16", bad.display())), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+mod common;
+mod report_check;
+
+/// `fit thermal` and `compensate` write report.html beside their output:
+/// self-contained, every plot with axes, units and data, the verdict's
+/// numbers the JSON's. A soak at one temperature leaves the temperature
+/// terms unresolved: the report says so.
+#[test]
+fn reports_and_their_warnings() {
+    let d = common::dir("thermal-report");
+    let p = |n: &str| d.join(n).display().to_string();
+    lab_json(&[
+        "simulate",
+        "chamber",
+        "--profile",
+        "cycle",
+        "--out",
+        &p("fit.csv"),
+    ]);
+    std::fs::create_dir_all(d.join("f")).unwrap();
+    let v = lab_json(&[
+        "fit",
+        "thermal",
+        "--data",
+        &p("fit.csv"),
+        "--out",
+        &p("f/c.toml"),
+    ]);
+    let html = std::fs::read_to_string(d.join("f").join("report.html")).unwrap();
+    report_check::check(&html, &v, 4, 12);
+    assert!(html.contains("Allan deviation of the residual against the noise floor"));
+    // Compensating the fit run itself.
+    let v = lab_json(&[
+        "compensate",
+        "--coeffs",
+        &p("f/c.toml"),
+        "--data",
+        &p("fit.csv"),
+        "--out",
+        &p("comp.csv"),
+    ]);
+    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    report_check::check(&html, &v, 2, 6);
+    // A soak: dT, T_K and their rates hardly move.
+    lab_json(&[
+        "simulate",
+        "chamber",
+        "--profile",
+        "soak",
+        "--soak-c",
+        "20",
+        "--duration-s",
+        "20000",
+        "--out",
+        &p("soak.csv"),
+    ]);
+    std::fs::create_dir_all(d.join("s")).unwrap();
+    let v = lab_json(&[
+        "fit",
+        "thermal",
+        "--data",
+        &p("soak.csv"),
+        "--out",
+        &p("s/c.toml"),
+    ]);
+    let html = std::fs::read_to_string(d.join("s").join("report.html")).unwrap();
+    let kinds = report_check::assert_warnings_match(&html, &v);
+    assert!(
+        kinds.iter().filter(|k| *k == "term_not_resolved").count() >= 3,
+        "{kinds:?}"
+    );
+    report_check::check(&html, &v, 4, 12);
+    // The soak's coefficients on the cycle: the run leaves the one
+    // temperature the fit saw, and the compensation report says where.
+    std::fs::create_dir_all(d.join("sc")).unwrap();
+    let v = lab_json(&[
+        "compensate",
+        "--coeffs",
+        &p("s/c.toml"),
+        "--data",
+        &p("fit.csv"),
+        "--out",
+        &p("sc/comp.csv"),
+    ]);
+    let html = std::fs::read_to_string(d.join("sc").join("report.html")).unwrap();
+    report_check::check(&html, &v, 2, 8);
+    let kinds = report_check::assert_warnings_match(&html, &v);
+    assert!(
+        kinds.iter().any(|k| k == "outside_calibrated_range"),
+        "{kinds:?}"
+    );
+    let spans = v["out_of_range_spans"].as_array().unwrap();
+    let [lo, hi] = [0, 1].map(|i| v["calibrated_range"]["mono_a_c"][i].as_f64().unwrap());
+    assert!(!spans.is_empty(), "{v}");
+    for s in spans {
+        let (a, b) = (s["min_c"].as_f64().unwrap(), s["max_c"].as_f64().unwrap());
+        assert!(a < lo || b > hi, "{s} inside {lo} .. {hi}");
+    }
+    assert!(
+        html.contains("outside the fit&#39;s temperatures")
+            || html.contains("outside the fit's temperatures")
+    );
+}

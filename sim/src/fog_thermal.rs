@@ -1,6 +1,8 @@
 //! A FOG over temperature (docs/fog.md): the scale factor varies with the
-//! coil temperature, piecewise linear with knees; the bias varies too; the
-//! coil follows the chamber air with a lag and its sensor lags the coil.
+//! coil temperature, piecewise linear with knees, on a background that may
+//! be smoothly curved (quadratic and cubic terms about a centre); the bias
+//! varies too; the coil follows the chamber air with a lag and its sensor
+//! lags the coil.
 //! Used by `gyro-lab simulate scale-factor` (run files at the rate level)
 //! and by the `qemu` firmware (the Sagnac phase scaled by the true scale
 //! factor, the coil sensor read through the frame path).
@@ -14,11 +16,19 @@ pub const MAX_KNEES: usize = 4;
 /// The true scale-factor error and bias over coil temperature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScaleFactorTruth {
-    /// Scale-factor error at 20 degC, ppm (output/input - 1 with the
-    /// nominal scale factor).
+    /// Scale-factor error at 20 degC of the linear part (the curvature
+    /// terms below add to it), ppm (output/input - 1 with the nominal
+    /// scale factor).
     pub sf_20c_ppm: f64,
-    /// Its slope below the first knee, ppm/degC.
+    /// The linear part's slope below the first knee, ppm/degC.
     pub slope_ppm_per_c: f64,
+    /// Smooth curvature: `quad * (T - centre)^2 + cubic * (T - centre)^3`
+    /// added to the error, ppm/degC^2 and ppm/degC^3 (0 for a coil whose
+    /// scale factor is piecewise linear).
+    pub quad_ppm_per_c2: f64,
+    pub cubic_ppm_per_c3: f64,
+    /// Centre of the curvature terms, degC.
+    pub curve_centre_c: f64,
     /// Knees: temperature, degC, and the slope change there, ppm/degC.
     pub knees: [(f64, f64); MAX_KNEES],
     pub n_knees: usize,
@@ -36,6 +46,9 @@ impl Default for ScaleFactorTruth {
         Self {
             sf_20c_ppm: 150.0,
             slope_ppm_per_c: 1.5,
+            quad_ppm_per_c2: 0.0,
+            cubic_ppm_per_c3: 0.0,
+            curve_centre_c: 10.0,
             knees: [(48.0, 6.0), (0.0, 0.0), (0.0, 0.0), (0.0, 0.0)],
             n_knees: 1,
             asymmetry_ppm: 1.0,
@@ -51,10 +64,47 @@ impl ScaleFactorTruth {
         Self { n_knees: 0, ..self }
     }
 
+    /// The same gyro with a smooth curvature about `centre_c`: `quad`
+    /// ppm/degC^2, `cubic` ppm/degC^3.
+    pub fn curved(self, quad: f64, cubic: f64, centre_c: f64) -> Self {
+        Self {
+            quad_ppm_per_c2: quad,
+            cubic_ppm_per_c3: cubic,
+            curve_centre_c: centre_c,
+            ..self
+        }
+    }
+
+    /// A smoothly curved coil with no knee: 0.02 ppm/degC^2 about 10 degC
+    /// on the default slope.
+    pub fn quadratic() -> Self {
+        Self::default().without_knees().curved(0.02, 0.0, 10.0)
+    }
+
+    /// A cubic coil with no knee: 2e-4 ppm/degC^3 about 10 degC (25 ppm
+    /// off the line at the ends of -40..+60 degC) on the default slope.
+    pub fn cubic() -> Self {
+        Self::default().without_knees().curved(0.0, 2e-4, 10.0)
+    }
+
+    /// The default knee (48 degC, +6 ppm/degC) on the quadratic's curved
+    /// background.
+    pub fn knee_on_curve() -> Self {
+        Self::default().curved(0.02, 0.0, 10.0)
+    }
+
+    /// Curvature of the error at `t_c`, ppm/degC^2 (the knees' none).
+    pub fn curvature_ppm_per_c2(&self, t_c: f64) -> f64 {
+        let x = t_c - self.curve_centre_c;
+        2.0 * self.quad_ppm_per_c2 + 6.0 * self.cubic_ppm_per_c3 * x
+    }
+
     /// Scale-factor error, ppm, at coil temperature `t_c` for a rate of sign
     /// `sign` (+1, -1; 0 for the mean of both).
     pub fn sf_ppm(&self, t_c: f64, sign: f64) -> f64 {
         let mut e = self.sf_20c_ppm + self.slope_ppm_per_c * (t_c - 20.0);
+        let x = t_c - self.curve_centre_c;
+        e += x * x * (self.quad_ppm_per_c2 + self.cubic_ppm_per_c3 * x);
         for &(tk, ds) in self.knees.iter().take(self.n_knees.min(MAX_KNEES)) {
             e += ds * (t_c - tk).max(0.0);
         }

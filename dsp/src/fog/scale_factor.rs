@@ -8,6 +8,11 @@
 //! difference between interpolating sf and 1/(1 + sf) is below 1e-8 for
 //! segments that change sf by less than 300 ppm).
 //!
+//! The table is read when the coil temperature changes, at each sensor
+//! update (a binary search over up to 64 nodes, 6 steps); the frame path
+//! applies the g and b read there, so its cost does not grow with the
+//! table (`compensate` is a subtraction, two multiplies and the words).
+//!
 //! Formats:
 //! - temperatures: i32 Q8 degC; the coil temperature is the sensor's plus
 //!   `lag * dT/dt` (the lead that undoes the sensor's first-order lag behind
@@ -71,6 +76,8 @@ pub struct ScaleFactorConfig {
     angle_per_closure_dph_q8: i64,
     /// Table input before the first good read: the calibrated range's middle.
     t_start_q8: i32,
+    /// The table read there: (g - 1, bias, outside the range).
+    start: (i32, i32, bool),
     pub coeffs_refused: bool,
 }
 
@@ -98,9 +105,10 @@ impl ScaleFactorConfig {
     /// `sensor_dt_s`: coil sensor period. A table that fails its check is
     /// replaced by no compensation with `coeffs_refused` up.
     pub fn new(table: &ScaleFactorTable, fog: &FogConfig, sensor_dt_s: f64) -> Self {
+        const SAFE: &ScaleFactorTable = &ScaleFactorTable::SAFE;
         let (t, refused) = match table.check() {
-            Ok(()) => (*table, false),
-            Err(_) => (ScaleFactorTable::SAFE, true),
+            Ok(()) => (table, false),
+            Err(_) => (SAFE, true),
         };
         let n = t.n;
         let mut c = Self {
@@ -114,6 +122,7 @@ impl ScaleFactorConfig {
             lead: DerivativeConfig::new(sensor_dt_s, LEAD_FILTER_TAU_S),
             angle_per_closure_dph_q8: 0,
             t_start_q8: q((t.temps_c[0] + t.temps_c[n - 1]) / 2.0, 8) as i32,
+            start: (0, 0, false),
             coeffs_refused: refused,
         };
         for k in 0..n {
@@ -133,6 +142,7 @@ impl ScaleFactorConfig {
         let rad_s_per_dph = core::f64::consts::PI / 180.0 / 3600.0;
         let per_step = rad_s_per_dph * fog.n_half as f64 * fog.k_sagnac_s / RAD_PER_PHASE_LSB;
         c.angle_per_closure_dph_q8 = q(per_step, 8);
+        c.start = c.lookup(c.t_start_q8);
         c
     }
 
@@ -140,10 +150,11 @@ impl ScaleFactorConfig {
     pub fn from_record(record: &[u8], fog: &FogConfig, sensor_dt_s: f64) -> Self {
         match ScaleFactorTable::from_record(record) {
             Ok(t) => Self::new(&t, fog, sensor_dt_s),
-            Err(_) => Self {
-                coeffs_refused: true,
-                ..Self::new(&ScaleFactorTable::SAFE, fog, sensor_dt_s)
-            },
+            Err(_) => {
+                let mut c = Self::new(&ScaleFactorTable::SAFE, fog, sensor_dt_s);
+                c.coeffs_refused = true;
+                c
+            }
         }
     }
 
@@ -157,18 +168,34 @@ impl ScaleFactorConfig {
         } else if t_q8 > self.t_q8[n - 1] {
             (n - 1, 0, n > 1)
         } else {
-            // Last node at or below t (at most n - 2 unless t is the last node).
-            let mut i = 0;
-            while i + 2 < n && self.t_q8[i + 1] <= t_q8 {
-                i += 1;
+            // Binary search for the last node at or below t, at most n - 2
+            // (t_q8[lo] <= t <= t_q8[hi] throughout): log2(n) steps.
+            let (mut lo, mut hi) = (0, n - 1);
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                if self.t_q8.get(mid).is_some_and(|&x| x <= t_q8) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
             }
-            (i, (t_q8 - self.t_q8[i]) as i64, false)
+            let t_lo = self.t_q8.get(lo).copied().unwrap_or(t_q8);
+            (lo, (t_q8 - t_lo) as i64, false)
         };
         // dt within the node span (< 2^16), slopes below 2^37 (differences
         // below 2^28 over at least 128 LSB, Q16): products below 2^53.
-        let g = self.g_q32[i] as i64 + ((self.g_slope_q16[i] * dt) >> 16);
-        let b = self.bias_q16[i] as i64 + ((self.bias_slope_q16[i] * dt) >> 16);
-        (g as i32, b as i32, out)
+        let at = |v: &[i32; MAX_NODES], s: &[i64; MAX_NODES]| {
+            let (v, s) = (
+                v.get(i).copied().unwrap_or(0) as i64,
+                s.get(i).copied().unwrap_or(0),
+            );
+            (v + ((s * dt) >> 16)) as i32
+        };
+        (
+            at(&self.g_q32, &self.g_slope_q16),
+            at(&self.bias_q16, &self.bias_slope_q16),
+            out,
+        )
     }
 }
 
@@ -181,7 +208,8 @@ fn mul_q32(x: i64, g: i32) -> i64 {
     hi * g as i64 + ((lo * g as i64) >> 32)
 }
 
-/// Mutable state: the coil sensor and its lead.
+/// Mutable state: the coil sensor and its lead, and the table read at the
+/// coil temperature.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ScaleFactorComp {
     sensor: SensorHold,
@@ -189,6 +217,10 @@ pub struct ScaleFactorComp {
     /// Coil temperature estimate, Q8 degC; None before the first good read.
     t_coil_q8: Option<i32>,
     sensor_bad: bool,
+    /// The table at `t_coil_q8`: g - 1 (2^-32), bias (Q16 deg/h), outside
+    /// the calibrated range. Read at each update; meaningless while
+    /// `t_coil_q8` is None.
+    read: (i32, i32, bool),
 }
 
 impl ScaleFactorComp {
@@ -204,10 +236,13 @@ impl ScaleFactorComp {
         let lead_q8 = (cfg.lag_q16 * d_q32) >> 40;
         let t_coil = (t as i64 + lead_q8).clamp(-200 * 256, 200 * 256) as i32;
         self.t_coil_q8 = Some(t_coil);
+        self.read = cfg.lookup(t_coil);
     }
 
     /// Compensates one frame's angle increment (`closures` closures):
-    /// returns `(y - b) * g` and the words that say what was applied.
+    /// returns `(y - b) * g` and the words that say what was applied. The
+    /// table was read at the last update (before the first good read, at
+    /// the middle of the calibrated range: `cfg` holds that reading).
     #[inline]
     pub fn compensate(
         &self,
@@ -215,8 +250,10 @@ impl ScaleFactorComp {
         angle: i64,
         closures: u16,
     ) -> (i64, FogTempWords) {
-        let t = self.t_coil_q8.unwrap_or(cfg.t_start_q8);
-        let (g, b_q16, out) = cfg.lookup(t);
+        let (t, (g, b_q16, out)) = match self.t_coil_q8 {
+            Some(t) => (t, self.read),
+            None => (cfg.t_start_q8, cfg.start),
+        };
         // |b| <= 2^26 (Q16), per-closure factor < 2^26 (Q8): per closure below
         // 2^36 (Q8), times closures < 2^16: below 2^52.
         let b_closure_q8 = (b_q16 as i64 * cfg.angle_per_closure_dph_q8) >> 16;

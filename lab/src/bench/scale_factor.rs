@@ -9,13 +9,22 @@
 //! firmware's fixed-point code; the figure is the RMS of the scale-factor
 //! error over 60 s means. A no-knee gyro's fit run checks that no knee is
 //! invented.
+//!
+//! The model families: five coils (a knee on a straight line, a straight
+//! line, a quadratic, a cubic, a knee on the quadratic's curved
+//! background), each fitted on the issue's run (the same cycle at +-100
+//! deg/s, 0.01 deg/sqrt(h)) and validated on the steps profile at -100
+//! deg/s: the family and degree chosen against the truth's,
+//! the knees, the curvature with its interval, the validation RMS.
 
 use crate::calibration::scale_factor::compensation::compensate_rows;
+use crate::calibration::scale_factor::families::Family;
 use crate::calibration::scale_factor::fit::fit;
 use crate::calibration::scale_factor::input::{prepare, SfInput};
 use crate::calibration::scale_factor::residual::{window_rms_ppm, RESIDUAL_WINDOW_S};
-use crate::calibration::scale_factor::result::SfFitError;
+use crate::calibration::scale_factor::result::{SfFit, SfFitError};
 use crate::sim::scale_factor_rig::{simulate, Direction, RigParams, Run, SweepProfile, Test};
+use gyro_sim::ScaleFactorTruth;
 
 /// The bench's runs that are fitted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,6 +32,8 @@ pub enum BenchRun {
     Continuous,
     MultiPoint,
     NoKnee,
+    /// One of the families' coils (its name).
+    Family(&'static str),
 }
 
 /// A fit that failed on the bench's own simulated run.
@@ -38,6 +49,7 @@ impl std::fmt::Display for BenchFitError {
             BenchRun::Continuous => "continuous fit",
             BenchRun::MultiPoint => "multi-point fit",
             BenchRun::NoKnee => "no-knee fit",
+            BenchRun::Family(name) => name,
         };
         write!(f, "{run}: {}", self.error)
     }
@@ -55,6 +67,20 @@ pub fn continuous_fit_test() -> Test {
         reverse_every_s: 300.0,
     }
 }
+
+/// The families' fit run (issue 25): the cycle at +-100 deg/s reversed
+/// every 5 min, with [`FAMILIES_ARW_DPSH`].
+pub fn families_fit_test() -> Test {
+    Test::Continuous {
+        profile: SweepProfile::Cycle,
+        rate_dps: 100.0,
+        direction: Direction::Both,
+        reverse_every_s: 300.0,
+    }
+}
+
+/// Angle random walk of the families' runs, deg/sqrt(h).
+pub const FAMILIES_ARW_DPSH: f64 = 0.01;
 
 pub fn validation_test() -> Test {
     Test::Continuous {
@@ -75,7 +101,7 @@ pub fn multipoint_test() -> Test {
 }
 
 /// Count, mean, standard deviation and largest of a figure over seeds.
-#[derive(Default, serde::Serialize)]
+#[derive(Clone, Default, serde::Serialize)]
 pub struct Stats {
     pub n: usize,
     pub mean: f64,
@@ -83,7 +109,7 @@ pub struct Stats {
     pub max: f64,
 }
 
-fn stats(v: &[f64]) -> Stats {
+pub fn stats(v: &[f64]) -> Stats {
     let n = v.len();
     if n == 0 {
         return Stats::default();
@@ -117,6 +143,191 @@ pub struct ScaleFactorBench {
     pub validation_continuous_ppm: Stats,
     pub multipoint_knee_bracketed: usize,
     pub no_knee_fitted_without_knee: usize,
+    /// The model families, one row per coil.
+    pub families: Vec<FamilyRow>,
+}
+
+/// A coil of the families' bench: what the fit should find.
+#[derive(Clone, Copy, Debug)]
+pub struct Coil {
+    pub name: &'static str,
+    pub truth: ScaleFactorTruth,
+    pub family: Family,
+    /// The JSON degree expected (0 for knees).
+    pub degree: usize,
+}
+
+/// The five coils.
+pub fn coils() -> [Coil; 5] {
+    let d = ScaleFactorTruth::default();
+    [
+        Coil {
+            name: "knee at 48 degC",
+            truth: d,
+            family: Family::Knees,
+            degree: 0,
+        },
+        Coil {
+            name: "straight line",
+            truth: d.without_knees(),
+            family: Family::Polynomial,
+            degree: 1,
+        },
+        Coil {
+            name: "quadratic 0.02 ppm/degC^2",
+            truth: ScaleFactorTruth::quadratic(),
+            family: Family::Polynomial,
+            degree: 2,
+        },
+        Coil {
+            name: "cubic 2e-4 ppm/degC^3",
+            truth: ScaleFactorTruth::cubic(),
+            family: Family::Polynomial,
+            degree: 3,
+        },
+        Coil {
+            name: "knee on the quadratic",
+            truth: ScaleFactorTruth::knee_on_curve(),
+            family: Family::PolynomialWithKnees,
+            degree: 2,
+        },
+    ]
+}
+
+/// One coil's figures over the seeds.
+#[derive(Clone, serde::Serialize)]
+pub struct FamilyRow {
+    pub coil: &'static str,
+    pub expected_model: Family,
+    pub expected_degree: usize,
+    /// Seeds fitted with the expected family and degree, and with the
+    /// truth's knee count.
+    pub right_model: usize,
+    pub right_knee_count: usize,
+    /// Models chosen: knees, polynomial, polynomial with knees.
+    pub chosen: [usize; 3],
+    /// Knee error where the knee count is right (the first knee), degC,
+    /// and seeds whose 95 % interval covers the truth.
+    pub knee_abs_err_c: Stats,
+    pub knee_ci_covers: usize,
+    /// The highest curvature term the truth has (x^2 or x^3 coefficient
+    /// about 20 degC, ppm/degC^k): the estimate and its 95 % interval's
+    /// coverage, where the right degree was chosen.
+    pub curvature_truth: f64,
+    pub curvature: Stats,
+    pub curvature_ci_covers: usize,
+    /// Table nodes and the firmware lookup's largest departure from the
+    /// fitted model, ppm.
+    pub table_nodes: Stats,
+    /// The closest node spacing of each seed's table, degC.
+    pub table_spacing_c: Stats,
+    pub tabulation_ppm: Stats,
+    /// Validation RMS of 60 s means through the firmware, ppm.
+    pub validation_ppm: Stats,
+}
+
+/// The coefficient of (T - 20)^k of a coil's truth (the curvature terms
+/// about their centre, re-expanded about 20 degC).
+fn truth_coef(t: &ScaleFactorTruth, k: usize) -> f64 {
+    let c = 20.0 - t.curve_centre_c;
+    match k {
+        2 => t.quad_ppm_per_c2 + 3.0 * t.cubic_ppm_per_c3 * c,
+        3 => t.cubic_ppm_per_c3,
+        _ => f64::NAN,
+    }
+}
+
+fn family_index(f: Family) -> usize {
+    match f {
+        Family::Knees => 0,
+        Family::Polynomial => 1,
+        Family::PolynomialWithKnees => 2,
+    }
+}
+
+/// Figures of one coil's fit gathered over seeds.
+#[derive(Default)]
+struct Gather {
+    right_model: usize,
+    right_knees: usize,
+    chosen: [usize; 3],
+    knee_err: Vec<f64>,
+    knee_covers: usize,
+    curv: Vec<f64>,
+    curv_covers: usize,
+    nodes: Vec<f64>,
+    spacing: Vec<f64>,
+    tab: Vec<f64>,
+    val: Vec<f64>,
+}
+
+impl Gather {
+    fn add(&mut self, coil: &Coil, f: &SfFit, val_ppm: f64) {
+        let t = &coil.truth;
+        self.chosen[family_index(f.model)] += 1;
+        if f.model == coil.family && f.degree == coil.degree {
+            self.right_model += 1;
+        }
+        if f.knees.len() == t.n_knees {
+            self.right_knees += 1;
+            if let (Some(k), Some(tk)) = (f.knees.first(), t.knees.first()) {
+                if t.n_knees > 0 {
+                    self.knee_err.push((k.value - tk.0).abs());
+                    if k.lo <= tk.0 && tk.0 <= k.hi {
+                        self.knee_covers += 1;
+                    }
+                }
+            }
+        }
+        let top = if t.cubic_ppm_per_c3 != 0.0 {
+            3
+        } else if t.quad_ppm_per_c2 != 0.0 {
+            2
+        } else {
+            0
+        };
+        if let (true, Some(p)) = (top > 0, &f.polynomial) {
+            if p.coef_ppm.len() == top + 1 {
+                let c = p.coef_ppm[top];
+                let truth = truth_coef(t, top);
+                self.curv.push(c.value);
+                if (c.value - truth).abs() <= 1.96 * c.se {
+                    self.curv_covers += 1;
+                }
+            }
+        }
+        self.nodes.push(f.tabulation.nodes as f64);
+        let closest = f
+            .tabulation
+            .spacing_c
+            .iter()
+            .fold(f64::INFINITY, |a, &h| a.min(h));
+        self.spacing.push(closest);
+        self.tab.push(f.tabulation.max_error_ppm);
+        self.val.push(val_ppm);
+    }
+
+    fn row(self, coil: &Coil) -> FamilyRow {
+        let t = &coil.truth;
+        let top = if t.cubic_ppm_per_c3 != 0.0 { 3 } else { 2 };
+        FamilyRow {
+            coil: coil.name,
+            expected_model: coil.family,
+            expected_degree: coil.degree,
+            right_model: self.right_model,
+            right_knee_count: self.right_knees,
+            chosen: self.chosen,
+            knee_abs_err_c: stats(&self.knee_err),
+            knee_ci_covers: self.knee_covers,
+            curvature_truth: truth_coef(t, top),
+            curvature: stats(&self.curv),
+            curvature_ci_covers: self.curv_covers,
+            table_nodes: stats(&self.nodes),
+            table_spacing_c: stats(&self.spacing),
+            tabulation_ppm: stats(&self.tab),
+            validation_ppm: stats(&self.val),
+        }
+    }
 }
 
 /// Runs the bench over seeds 1..=`seeds`; `progress` after each seed.
@@ -127,6 +338,8 @@ pub fn run(seeds: u64, mut progress: impl FnMut()) -> Result<ScaleFactorBench, B
     let (mut knee_err, mut knee_w, mut lag) = (vec![], vec![], vec![]);
     let (mut one_knee, mut covers, mut lag_covers, mut bracketed, mut no_knee_ok) = (0, 0, 0, 0, 0);
     let (mut raw, mut mp, mut cont) = (vec![], vec![], vec![]);
+    let coils = coils();
+    let mut gathered: Vec<Gather> = coils.iter().map(|_| Gather::default()).collect();
     for seed in 1..=seeds {
         let rig = |s: u64| RigParams { seed: s, ..base };
         let fit_run = simulate(&continuous_fit_test(), &rig(seed));
@@ -156,14 +369,7 @@ pub fn run(seeds: u64, mut progress: impl FnMut()) -> Result<ScaleFactorBench, B
             bracketed += 1;
         }
         let val = simulate(&validation_test(), &rig(seed + 20_000));
-        let ppm = |rate: &[f64]| {
-            let err: Vec<f64> = rate
-                .iter()
-                .zip(&val.ref_rate_dps)
-                .map(|(y, w)| y - w)
-                .collect();
-            window_rms_ppm(&val.t_s, &val.ref_rate_dps, &err, RESIDUAL_WINDOW_S).0
-        };
+        let ppm = |rate: &[f64]| validation_ppm(&val, rate);
         raw.push(ppm(&val.rate_dps));
         for (table, out) in [(&mf.table, &mut mp), (&cf.table, &mut cont)] {
             let (c, _) = compensate_rows(table, &val.t_s, &val.rate_dps, &val.temp_c);
@@ -177,6 +383,24 @@ pub fn run(seeds: u64, mut progress: impl FnMut()) -> Result<ScaleFactorBench, B
         let (nf, _) = fit(&input(&nk_run)).map_err(|e| fail(BenchRun::NoKnee, e))?;
         if nf.knees.is_empty() {
             no_knee_ok += 1;
+        }
+        for (j, (coil, g)) in coils.iter().zip(&mut gathered).enumerate() {
+            let p = RigParams {
+                truth: coil.truth,
+                arw_dpsh: FAMILIES_ARW_DPSH,
+                ..rig(seed + 40_000 + 1_000 * j as u64)
+            };
+            let (f, _) = fit(&input(&simulate(&families_fit_test(), &p)))
+                .map_err(|e| fail(BenchRun::Family(coil.name), e))?;
+            let v = simulate(
+                &validation_test(),
+                &RigParams {
+                    seed: p.seed + 500,
+                    ..p
+                },
+            );
+            let (c, _) = compensate_rows(&f.table, &v.t_s, &v.rate_dps, &v.temp_c);
+            g.add(coil, &f, validation_ppm(&v, &c));
         }
         progress();
     }
@@ -194,5 +418,16 @@ pub fn run(seeds: u64, mut progress: impl FnMut()) -> Result<ScaleFactorBench, B
         validation_continuous_ppm: stats(&cont),
         multipoint_knee_bracketed: bracketed,
         no_knee_fitted_without_knee: no_knee_ok,
+        families: coils.iter().zip(gathered).map(|(c, g)| g.row(c)).collect(),
     })
+}
+
+/// RMS of 60 s means of a validation run's scale-factor error, ppm.
+fn validation_ppm(val: &Run, rate: &[f64]) -> f64 {
+    let err: Vec<f64> = rate
+        .iter()
+        .zip(&val.ref_rate_dps)
+        .map(|(y, w)| y - w)
+        .collect();
+    window_rms_ppm(&val.t_s, &val.ref_rate_dps, &err, RESIDUAL_WINDOW_S).0
 }

@@ -17,6 +17,7 @@
 //! leakage, aliasing of the upper harmonics or noise in the magnitudes, which
 //! limit the plain harmonic ratio. Its covariance gives the uncertainty.
 
+use super::warning::Warning;
 use nalgebra::{SMatrix, SVector};
 use num_complex::Complex64 as C;
 use realfft::RealFftPlanner;
@@ -40,6 +41,85 @@ pub struct ChannelFit {
     pub residual_rms: f64,
     /// Complex fundamental amplitude (time origin at the record's middle).
     pub fundamental: (f64, f64),
+    /// Samples, and the white noise under the fit's residual (the median
+    /// of its spectrum: what the residual's RMS reaches when the model
+    /// leaves nothing but noise).
+    pub samples: usize,
+    pub noise_rms: f64,
+    /// The fitted model: A, c, phi, theta0, rho, w (see [`fringe_model`]),
+    /// time origin `t_mid`.
+    #[serde(skip)]
+    pub params: [f64; 6],
+    #[serde(skip)]
+    pub t_mid: f64,
+}
+
+/// The fitted fringe model at time `t`: `A*Im(exp(i*phi')*w(theta)) + c`
+/// with the parameters of [`ChannelFit::params`].
+pub fn fringe_model(p: &[f64; 6], t_mid: f64, t: f64) -> f64 {
+    let (a, c0, phi, th0, rho, w) = (p[0], p[1], p[2], p[3], p[4], p[5]);
+    let u = C::from_polar(1.0, phi - th0);
+    let z = C::from_polar(1.0, w * (t - t_mid) + th0);
+    let wz = (z + rho) / (C::new(1.0, 0.0) + z * rho);
+    a * (u * wz).im + c0
+}
+
+/// Amplitudes of the first `n` harmonics of the beat `f` (Hz) in the
+/// record, Hann-windowed, its mean removed (one pass: each sample's phasor
+/// raised to the harmonics by multiplication).
+pub fn harmonic_amplitudes(t: &[f64], x: &[f64], f: f64, n: usize) -> Vec<f64> {
+    let len = t.len();
+    if len == 0 || n == 0 {
+        return vec![];
+    }
+    let mean = x.iter().sum::<f64>() / len as f64;
+    let tm = 0.5 * (t[0] + t[len - 1]);
+    let mut acc = vec![C::new(0.0, 0.0); n];
+    let mut wsum = 0.0;
+    for (k, (&tk, &xk)) in t.iter().zip(x).enumerate() {
+        let w = 0.5 - 0.5 * (TAU * (k as f64 + 0.5) / len as f64).cos();
+        let z = C::from_polar(1.0, -TAU * f * (tk - tm));
+        let mut zn = C::new((xk - mean) * w, 0.0);
+        for a in acc.iter_mut() {
+            zn *= z;
+            *a += zn;
+        }
+        wsum += w;
+    }
+    acc.iter()
+        .map(|a| (a * C::new(0.0, 2.0) / wsum).norm())
+        .collect()
+}
+
+/// The white-noise RMS under a residual: the median of its Hann-windowed
+/// periodogram (for white noise each bin is exponential, its median ln 2
+/// times its mean), so a tone or structure left in the residual, which
+/// lifts a few bins, does not lift it. Compared with the residual's RMS it
+/// says whether the fit left anything but noise.
+fn noise_floor_rms(r: &[f64]) -> f64 {
+    let n = r.len();
+    if n < 16 {
+        return f64::NAN;
+    }
+    let win: Vec<f64> = (0..n)
+        .map(|k| 0.5 - 0.5 * (TAU * (k as f64 + 0.5) / n as f64).cos())
+        .collect();
+    let mut buf: Vec<f64> = r.iter().zip(&win).map(|(x, w)| x * w).collect();
+    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let mut spec = fft.make_output_vec();
+    if fft.process(&mut buf, &mut spec).is_err() {
+        return f64::NAN;
+    }
+    let mut p: Vec<f64> = spec[1..spec.len() - 1]
+        .iter()
+        .map(|c| c.norm_sqr())
+        .collect();
+    if p.is_empty() {
+        return f64::NAN;
+    }
+    p.sort_by(f64::total_cmp);
+    let w2: f64 = win.iter().map(|w| w * w).sum();
+    (p[p.len() / 2] / std::f64::consts::LN_2 / w2).sqrt()
 }
 
 #[derive(Debug)]
@@ -244,6 +324,12 @@ pub fn fit_channel(t: &[f64], x: &[f64]) -> Result<ChannelFit, EstimateError> {
     // A negative rho is the same solution half a turn on (z -> -z).
     let rho = p[4].abs();
     let var = cost / (n.saturating_sub(6).max(1)) as f64;
+    let params = [p[0], p[1], p[2], p[3], p[4], p[5]];
+    let resid: Vec<f64> = t
+        .iter()
+        .zip(x)
+        .map(|(&tk, &xk)| xk - fringe_model(&params, tm, tk))
+        .collect();
     let cov = jj.try_inverse().map(|inv| inv * var);
     let sd = |i: usize| cov.map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt());
     Ok(ChannelFit {
@@ -256,6 +342,10 @@ pub fn fit_channel(t: &[f64], x: &[f64]) -> Result<ChannelFit, EstimateError> {
         a2_over_a1,
         residual_rms: var.sqrt(),
         fundamental: (c1.re, c1.im),
+        samples: n,
+        noise_rms: noise_floor_rms(&resid),
+        params,
+        t_mid: tm,
     })
 }
 
@@ -278,6 +368,84 @@ pub struct LockIn {
     /// |A2/A1| of the windowed spectrum (mean over the channels).
     pub a2_over_a1: f64,
     pub channels: usize,
+    /// 95 % interval of the lock-in rate from the fit (+-1.96 sigma), deg/s.
+    pub lock_in_ci_dps: [f64; 2],
+    /// Omega_I/Omega_L of the estimate.
+    pub rate_ratio: f64,
+    /// The fit's relative one-sigma uncertainty of the lock-in rate, and
+    /// the Cramer-Rao bound for this record (physics.md 2.1: sigma/(sqrt(N)
+    /// A rho) from the pair with unknown offsets, sqrt(2) more from one
+    /// channel; the small-lock-in form, exact for Omega_I/Omega_L >= 10).
+    pub lock_in_rel_std: f64,
+    pub cramer_rao_rel: f64,
+    /// Residual RMS of the fit against the record's noise (second
+    /// differences), means over the channels.
+    pub residual_rms: f64,
+    pub noise_rms: f64,
+    pub samples: usize,
+    pub duration_s: f64,
+    pub warnings: Vec<Warning>,
+    /// Each channel's fit.
+    pub channel_fits: Vec<ChannelFit>,
+}
+
+/// The small-lock-in Cramer-Rao bound on the relative error of Omega_L
+/// (physics.md 2.1): `sigma/(sqrt(N) A rho)` from the quadrature pair with
+/// unknown offsets, sqrt(2) more from one channel.
+pub fn cramer_rao_rel(noise_over_amplitude: f64, samples: usize, rho: f64, channels: usize) -> f64 {
+    let one = if channels >= 2 { 1.0 } else { 2f64.sqrt() };
+    one * noise_over_amplitude / ((samples.max(1) as f64).sqrt() * rho)
+}
+
+/// The harmonic ratio for Omega_I/Omega_L = `ratio` (> 1): r - sqrt(r^2 - 1).
+pub fn rho_of_ratio(ratio: f64) -> f64 {
+    ratio - (ratio * ratio - 1.0).max(0.0).sqrt()
+}
+
+/// A fit whose residual stands this far above the record's noise is
+/// warned about; so is a relative one-sigma above [`INFORMATION_LIMIT`],
+/// and a fit this far above its bound.
+pub const RESIDUAL_OVER_NOISE: f64 = 1.2;
+pub const INFORMATION_LIMIT: f64 = 0.005;
+pub const OVER_BOUND: f64 = 1.5;
+
+fn lockin_warnings(r: &LockIn) -> Vec<Warning> {
+    let mut w = vec![];
+    if r.residual_rms > RESIDUAL_OVER_NOISE * r.noise_rms {
+        w.push(Warning::new(
+            "residual_above_noise",
+            format!(
+                "the fit's residual ({:.3e} RMS) is {:.2} times the noise under it ({:.3e}, from its \
+                 spectrum's median): the record holds more than the lock-in equation's fringe (a rate \
+                 that changes during the record, a second mode, clipping)",
+                r.residual_rms,
+                r.residual_rms / r.noise_rms,
+                r.noise_rms
+            ),
+        ));
+    }
+    if r.lock_in_rel_std > INFORMATION_LIMIT {
+        w.push(Warning::new(
+            "record_too_short",
+            format!(
+                "the record's information limits the lock-in rate to +-{:.2} % (one sigma) at \
+                 Omega_I/Omega_L = {:.0}: a longer record, less noise, both photodiodes or a lower \
+                 input rate would narrow it",
+                100.0 * r.lock_in_rel_std,
+                r.rate_ratio
+            ),
+        ));
+    }
+    if r.rate_ratio >= 10.0 && r.lock_in_rel_std > OVER_BOUND * r.cramer_rao_rel {
+        w.push(Warning::new(
+            "above_the_bound",
+            format!(
+                "the fit's uncertainty is {:.1} times the Cramer-Rao bound for this record",
+                r.lock_in_rel_std / r.cramer_rao_rel
+            ),
+        ));
+    }
+    w
 }
 
 /// Lock-in from a record: one channel, or a quadrature pair (then the two fits
@@ -330,9 +498,14 @@ pub fn lock_in(
     } else {
         2.0 * (1.0 + rho * rho) / (g * g) * fk
     };
-    Ok(LockIn {
+    let std = dl_drho * rho_std;
+    let amp = fits.iter().map(|f| f.amplitude).sum::<f64>() / nf;
+    let resid = fits.iter().map(|f| f.residual_rms).sum::<f64>() / nf;
+    let noise = fits.iter().map(|f| f.noise_rms).sum::<f64>() / nf;
+    let n = t.len();
+    let mut r = LockIn {
         lock_in_dps: lock_in,
-        lock_in_std_dps: dl_drho * rho_std,
+        lock_in_std_dps: std,
         input_rate_dps: omega_i,
         input_rate_given: given,
         input_rate_est_dps: omega_i_est,
@@ -341,5 +514,17 @@ pub fn lock_in(
         lock_in_approx_dps: omega_i.abs() / (1.0 + (1.0 / (2.0 * a21)).powi(2)).sqrt(),
         a2_over_a1: a21,
         channels: fits.len(),
-    })
+        lock_in_ci_dps: [lock_in - 1.96 * std, lock_in + 1.96 * std],
+        rate_ratio: omega_i.abs() / lock_in,
+        lock_in_rel_std: std / lock_in,
+        cramer_rao_rel: cramer_rao_rel(resid / amp, n, rho, fits.len()),
+        residual_rms: resid,
+        noise_rms: noise,
+        samples: n,
+        duration_s: t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0),
+        warnings: vec![],
+        channel_fits: fits,
+    };
+    r.warnings = lockin_warnings(&r);
+    Ok(r)
 }

@@ -6,3 +6,4 @@
 pub mod lockin;
 pub mod scale_factor;
 pub mod thermal;
+pub mod warning;

@@ -32,3 +32,11 @@ pub struct OutOpt {
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
+
+/// `--no-report`: skip the report.html a command writes beside its output
+/// (for scripted loops; the JSON and the other files are unchanged).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct NoReport {
+    #[arg(long)]
+    pub no_report: bool,
+}

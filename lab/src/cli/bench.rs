@@ -175,6 +175,80 @@ fn print_scale_factor(j: &ScaleFactorBench) {
         "no-knee gyro fitted with no knee: {}/{n}",
         j.no_knee_fitted_without_knee
     );
+    print_families(j);
+}
+
+/// The model families' table: per coil, the model chosen against the
+/// truth's, the knee, the curvature, the table and the validation.
+fn print_families(j: &ScaleFactorBench) {
+    let n = j.seeds;
+    println!();
+    println!(
+        "model families (fit: cycle -40..+60 degC, +-100 deg/s, 0.01 deg/sqrt(h); validation: steps, -100 deg/s; RMS of 60 s means)"
+    );
+    let head = [
+        "coil",
+        "expected",
+        "right",
+        "chosen K/P/PK",
+        "knee err degC mean/max (CI covers)",
+        "top coefficient mean vs truth (CI covers)",
+        "table nodes / spacing degC / max err ppm",
+        "validation ppm mean +- sd (max)",
+    ];
+    let mut rows: Vec<Vec<String>> = vec![head.iter().map(|h| h.to_string()).collect()];
+    for r in &j.families {
+        let knee = if r.knee_abs_err_c.n > 0 {
+            format!(
+                "{:.3} / {:.3} ({}/{})",
+                r.knee_abs_err_c.mean, r.knee_abs_err_c.max, r.knee_ci_covers, r.knee_abs_err_c.n
+            )
+        } else {
+            "-".into()
+        };
+        let curv = if r.curvature.n > 0 {
+            format!(
+                "{:.3e} vs {:.1e} ({}/{})",
+                r.curvature.mean, r.curvature_truth, r.curvature_ci_covers, r.curvature.n
+            )
+        } else {
+            "-".into()
+        };
+        rows.push(vec![
+            r.coil.to_string(),
+            format!("{} {}", r.expected_model, r.expected_degree),
+            format!("{}/{n}", r.right_model),
+            format!("{}/{}/{}", r.chosen[0], r.chosen[1], r.chosen[2]),
+            knee,
+            curv,
+            format!(
+                "{:.0} / {:.2} / {:.3}",
+                r.table_nodes.mean, r.table_spacing_c.mean, r.tabulation_ppm.max
+            ),
+            format!(
+                "{:.3} +- {:.3} ({:.3})",
+                r.validation_ppm.mean, r.validation_ppm.sd, r.validation_ppm.max
+            ),
+        ]);
+    }
+    let widths: Vec<usize> = (0..head.len())
+        .map(|c| rows.iter().map(|r| r[c].len()).max().unwrap_or(0))
+        .collect();
+    for r in &rows {
+        let cells: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (x, &w))| {
+                if c < 2 {
+                    format!("{x:<w$}")
+                } else {
+                    format!("{x:>w$}")
+                }
+            })
+            .collect();
+        println!("{}", cells.join("  "));
+    }
 }
 
 #[derive(Args, Debug, Clone)]

@@ -2,13 +2,15 @@
 //! applied to a run as the firmware applies it (the same code, the same
 //! fixed-point arithmetic); the run written back with `rate_comp_dps`.
 
-use crate::calibration::scale_factor::compensation::compensate_rows;
-use crate::calibration::scale_factor::residual::{window_rms_ppm, RESIDUAL_WINDOW_S};
+use crate::calibration::scale_factor::validation::{validate, Validation};
 use crate::calibration::thermal::compensation::compensate;
 use crate::calibration::thermal::fit::CubicModel;
-use crate::calibration::thermal::summary::compensation_summary;
-use crate::cli::args::{Json, Out};
-use crate::cli::output::print_json;
+use crate::calibration::thermal::summary::{
+    compensation_summary, CalibratedRange, CompensateSummary,
+};
+use crate::cli::args::{Json, NoReport, Out};
+use crate::cli::output::{print_json, write_report};
+use crate::cli::reports;
 use crate::cli::run_inputs::thermal_run;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
@@ -31,19 +33,50 @@ pub struct CompensateArgs {
     #[arg(long)]
     pub cubic_from: Option<PathBuf>,
     #[command(flatten)]
+    pub no_report: NoReport,
+    #[command(flatten)]
     pub json: Json,
 }
 
+/// JSON of `compensate` with RLG thermal coefficients.
+#[derive(serde::Serialize)]
+struct ThermalJson<'a> {
+    #[serde(flatten)]
+    s: &'a CompensateSummary,
+    report: Option<String>,
+}
+
 pub fn run(a: &CompensateArgs) -> Result<(), LabError> {
-    let (_, coeffs) =
+    let (file, coeffs) =
         gyro_coeffs::file::read(&a.coeffs).map_err(|e| LabError::coeffs_input(&a.coeffs, &e))?;
     match coeffs {
-        Coeffs::RlgThermal(c) => rlg_thermal(a, &c),
+        Coeffs::RlgThermal(c) => rlg_thermal(a, &c, file.fit.as_ref().and_then(thermal_range)),
         Coeffs::FogScaleFactor(t) => fog_scale_factor(a, &t),
     }
 }
 
-fn rlg_thermal(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
+/// The temperatures a thermal fit saw, from its file's `[fit]` table
+/// (files written before they were kept there have none).
+fn thermal_range(fit: &toml::Table) -> Option<CalibratedRange> {
+    let pair = |k: &str| -> Option<[f64; 2]> {
+        let v = fit.get(k)?.as_array()?;
+        let f = |i: usize| {
+            v.get(i)
+                .and_then(|x| x.as_float().or(x.as_integer().map(|n| n as f64)))
+        };
+        Some([f(0)?, f(1)?])
+    };
+    Some(CalibratedRange {
+        mono_a_c: pair("mono_a_range_c")?,
+        case_c: pair("case_range_c")?,
+    })
+}
+
+fn rlg_thermal(
+    a: &CompensateArgs,
+    c: &ThermalCoeffs,
+    range: Option<CalibratedRange>,
+) -> Result<(), LabError> {
     let (text, d) = thermal_run(&a.data)?;
     let (comp, flags) = compensate(c, &d, &text.run.rate_dps);
     text.write_back(&a.out.out, &[(Column::CompensatedRate, &comp)])?;
@@ -63,9 +96,18 @@ fn rlg_thermal(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
         &text.run.ref_rate_dps,
         (&comp, &flags),
         cubic.as_ref(),
+        range,
     );
+    let report = (!a.no_report.no_report).then(|| reports::beside(&a.out.out));
+    if let Some(path) = &report {
+        let names = (a.coeffs.display().to_string(), a.data.display().to_string());
+        write_report(&reports::compensate::thermal(&names, &d, &s), path)?;
+    }
     if a.json.json {
-        return print_json(&s);
+        return print_json(&ThermalJson {
+            s: &s,
+            report: report.map(|p| p.display().to_string()),
+        });
     }
     println!(
         "std of 100 s means: raw {:.4} +- {:.4} deg/h, compensated {:.4} +- {:.4} deg/h ({:.2}x the noise floor {:.4} +- {:.4}){}",
@@ -84,13 +126,19 @@ fn rlg_thermal(a: &CompensateArgs, c: &ThermalCoeffs) -> Result<(), LabError> {
             "coefficients refused by the firmware check: ran on the safe set (no compensation)"
         );
     }
+    for w in &s.warnings {
+        println!("warning: {}", w.message);
+    }
     println!("written: {}", a.out.out.display());
+    if let Some(p) = report {
+        println!("report: {}", p.display());
+    }
     Ok(())
 }
 
 /// JSON of `compensate` with a scale-factor table.
 #[derive(serde::Serialize)]
-struct ScaleFactorJson {
+struct ScaleFactorJson<'a> {
     /// RMS of the scale-factor error over 60 s means of the rotating rows,
     /// ppm, before and after, with standard errors.
     raw_ppm: f64,
@@ -100,41 +148,61 @@ struct ScaleFactorJson {
     windows: usize,
     flags_seen: u8,
     out: String,
+    #[serde(flatten)]
+    v: &'a Validation,
+    report: Option<String>,
 }
 
 fn fog_scale_factor(a: &CompensateArgs, table: &ScaleFactorTable) -> Result<(), LabError> {
     let (text, [temp]) = RunFile::read(&a.data, 2, [Column::Temp])?;
     let (t, w, y) = (&text.run.t_s, &text.run.ref_rate_dps, &text.run.rate_dps);
-    let (comp, flags) = compensate_rows(table, t, y, &temp);
-    text.write_back(&a.out.out, &[(Column::CompensatedRate, &comp)])?;
-    let err = |v: &[f64]| -> Vec<f64> { v.iter().zip(w).map(|(a, b)| a - b).collect() };
-    let (raw, raw_se, _) = window_rms_ppm(t, w, &err(y), RESIDUAL_WINDOW_S);
-    let (c, c_se, m) = window_rms_ppm(t, w, &err(&comp), RESIDUAL_WINDOW_S);
-    let s = ScaleFactorJson {
-        raw_ppm: raw,
-        raw_ppm_se: raw_se,
-        comp_ppm: c,
-        comp_ppm_se: c_se,
-        windows: m,
-        flags_seen: flags.iter().fold(0, |x, f| x | f),
-        out: a.out.out.display().to_string(),
-    };
+    let v = validate(table, t, w, y, &temp);
+    text.write_back(&a.out.out, &[(Column::CompensatedRate, &v.comp_dps)])?;
+    let report = (!a.no_report.no_report).then(|| reports::beside(&a.out.out));
+    if let Some(path) = &report {
+        let names = (a.coeffs.display().to_string(), a.data.display().to_string());
+        write_report(&reports::compensate::scale_factor(&names, &v), path)?;
+    }
+    let (raw, raw_se, c, c_se, m) = (
+        v.raw_ppm.value,
+        v.raw_ppm.se,
+        v.comp_ppm.value,
+        v.comp_ppm.se,
+        v.windows,
+    );
     if a.json.json {
-        return print_json(&s);
+        return print_json(&ScaleFactorJson {
+            raw_ppm: raw,
+            raw_ppm_se: raw_se,
+            comp_ppm: c,
+            comp_ppm_se: c_se,
+            windows: m,
+            flags_seen: v.flags_seen,
+            out: a.out.out.display().to_string(),
+            v: &v,
+            report: report.map(|p| p.display().to_string()),
+        });
     }
     if m == 0 {
         println!("no 60 s stretch at a constant nonzero rate: no scale-factor figure");
     } else {
         println!(
-            "scale-factor error, RMS of {m} 60 s means: raw {raw:.2} +- {raw_se:.2} ppm, compensated {c:.3} +- {c_se:.3} ppm"
+            "scale-factor error, RMS of {m} 60 s means: raw {raw:.2} +- {raw_se:.2} ppm, compensated {c:.3} +- {c_se:.3} ppm (noise floor {:.3})",
+            v.noise_floor_ppm.value
         );
     }
-    if s.flags_seen != 0 {
+    if v.flags_seen != 0 {
         println!(
             "flags seen {:#04x} (1 coil sensor bad, 2 outside the calibrated range, 4 table refused)",
-            s.flags_seen
+            v.flags_seen
         );
     }
+    for w in &v.warnings {
+        println!("warning: {}", w.message);
+    }
     println!("written: {}", a.out.out.display());
+    if let Some(p) = report {
+        println!("report: {}", p.display());
+    }
     Ok(())
 }

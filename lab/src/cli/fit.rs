@@ -2,12 +2,14 @@
 //! calibrations of calibration/ on a test-rig run, written as the
 //! coefficient files the firmware loads.
 
+use crate::calibration::scale_factor::diagnostics::diagnostics;
 use crate::calibration::scale_factor::fit::fit;
 use crate::calibration::scale_factor::multipoint::Plateau;
 use crate::calibration::scale_factor::result::{Segment, SfFit};
-use crate::calibration::thermal::summary::calibrate;
-use crate::cli::args::{Json, Out};
-use crate::cli::output::print_json;
+use crate::calibration::thermal::summary::{calibrate, FitSummary};
+use crate::cli::args::{Json, NoReport, Out};
+use crate::cli::output::{print_json, write_report};
+use crate::cli::reports;
 use crate::cli::run_inputs::{scale_factor_run, thermal_run};
 use crate::error::LabError;
 use clap::Args;
@@ -22,7 +24,17 @@ pub struct FitThermalArgs {
     #[command(flatten)]
     pub out: Out,
     #[command(flatten)]
+    pub no_report: NoReport,
+    #[command(flatten)]
     pub json: Json,
+}
+
+/// JSON of `fit thermal`: the summary and the report's path.
+#[derive(serde::Serialize)]
+struct ThermalJson<'a> {
+    #[serde(flatten)]
+    summary: &'a FitSummary,
+    report: Option<String>,
 }
 
 pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
@@ -40,6 +52,12 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
     ] {
         info.insert(k.into(), v.into());
     }
+    for (k, [lo, hi]) in [
+        ("mono_a_range_c", s.mono_a_range_c),
+        ("case_range_c", s.case_range_c),
+    ] {
+        info.insert(k.into(), toml::Value::Array(vec![lo.into(), hi.into()]));
+    }
     info.insert(
         "record_crc32".into(),
         format!("0x{:08x}", gyro_coeffs::record::crc_of(&c.to_record())).into(),
@@ -53,8 +71,16 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
          dT = t_mono_a - t_mono_b. Load with `gyro-lab compensate` or build the firmware with RLG_COEFFS=<this file>.",
     )
     .map_err(|e| LabError::coeffs_io(&a.out.out, &e))?;
+    let report = (!a.no_report.no_report).then(|| reports::beside(&a.out.out));
+    if let Some(path) = &report {
+        let name = a.data.display().to_string();
+        write_report(&reports::thermal::report(&name, &d, &s), path)?;
+    }
     if a.json.json {
-        print_json(&s)?;
+        print_json(&ThermalJson {
+            summary: &s,
+            report: report.map(|p| p.display().to_string()),
+        })?;
     } else {
         let v = s.coefficients.values();
         let e = s.coefficient_se.map(|c| c.values());
@@ -86,7 +112,13 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
             s.noise_floor_100s_dph,
             se[3]
         );
+        for w in &s.warnings {
+            println!("warning: {}", w.message);
+        }
         println!("written: {}", a.out.out.display());
+        if let Some(p) = report {
+            println!("report: {}", p.display());
+        }
     }
     Ok(())
 }
@@ -99,6 +131,8 @@ pub struct FitScaleFactorArgs {
     pub data: PathBuf,
     #[command(flatten)]
     pub out: Out,
+    #[command(flatten)]
+    pub no_report: NoReport,
     #[command(flatten)]
     pub json: Json,
 }
@@ -117,6 +151,8 @@ struct FitJson<'a> {
     plateaus: Option<&'a [Plateau]>,
     table: TableJson,
     out: String,
+    /// The report written beside `out` (null with --no-report).
+    report: Option<String>,
 }
 
 #[derive(serde::Serialize)]
@@ -141,6 +177,13 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
         )
     })?;
     let crc = write_table(a, &f)?;
+    let report = (!a.no_report.no_report).then(|| reports::beside(&a.out.out));
+    if let Some(path) = &report {
+        let d = diagnostics(&inp, &f);
+        let name = a.data.display().to_string();
+        let r = reports::scale_factor::report(&name, &f, &d, plateaus.as_deref());
+        write_report(&r, path)?;
+    }
     let n = f.table.n;
     if a.json.json {
         return print_json(&FitJson {
@@ -159,9 +202,13 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
                 record_crc32: crc,
             },
             out: a.out.out.display().to_string(),
+            report: report.map(|p| p.display().to_string()),
         });
     }
     print_text(&f, &crc, &a.out.out);
+    if let Some(p) = report {
+        println!("report: {}", p.display());
+    }
     Ok(())
 }
 
@@ -195,6 +242,24 @@ fn print_text(f: &SfFit, crc: &str, out: &std::path::Path) {
         "{} fit, {} rows, coil {:.2} .. {:.2} degC",
         f.method, f.rows_used, f.range_c[0], f.range_c[1]
     );
+    println!(
+        "model: {} ({}), degree {}, {} knee(s); BIC margin over the next family {:.1}",
+        f.model,
+        f.model.describe(),
+        f.degree,
+        f.knees.len(),
+        f.criterion_margin
+    );
+    for b in &f.families {
+        println!(
+            "  best {:<22} degree {} knees {}: BIC {:.1} ({:+.1})",
+            b.model.name(),
+            b.degree,
+            b.knees,
+            b.bic,
+            b.delta_bic
+        );
+    }
     if f.knees.is_empty() {
         println!("knees: none (BIC by knee count: {:?})", rounded(&f.bic));
     }
@@ -207,7 +272,36 @@ fn print_text(f: &SfFit, crc: &str, out: &std::path::Path) {
             rounded(&f.bic)
         );
     }
-    for s in &f.segments {
+    if let Some(p) = &f.polynomial {
+        let terms: Vec<String> = p
+            .coef_ppm
+            .iter()
+            .enumerate()
+            .map(|(k, c)| format!("{:+.6} ({:.6}) x^{k}", c.value, c.se))
+            .collect();
+        println!(
+            "polynomial, x = T - {} degC, ppm: {}",
+            p.t_ref_c,
+            terms.join(" ")
+        );
+    }
+    let t = &f.tabulation;
+    println!(
+        "table: {} nodes, spacing {:?} degC, firmware lookup within {:.4} ppm of the model",
+        t.nodes,
+        t.spacing_c
+            .iter()
+            .map(|h| (h * 1000.0).round() / 1000.0)
+            .collect::<Vec<_>>(),
+        t.max_error_ppm
+    );
+    if f.segments.len() > 12 {
+        println!(
+            "  {} table segments (the polynomial tabulated): see the JSON's segments",
+            f.segments.len()
+        );
+    }
+    for s in f.segments.iter().filter(|_| f.segments.len() <= 12) {
         println!(
             "  {:7.2} .. {:7.2} degC: K_SF = 1 {:+.2} ppm ({:.2}) {:+.4} ppm/degC ({:.4}) x T",
             s.from_c,
@@ -240,11 +334,14 @@ fn print_text(f: &SfFit, crc: &str, out: &std::path::Path) {
         }
     }
     println!(
-        "residual {:.3} +- {:.3} ppm RMS of 60 s means",
-        f.residual_ppm.value, f.residual_ppm.se
+        "residual {:.3} +- {:.3} ppm RMS of 60 s means (noise floor {:.3} +- {:.3})",
+        f.residual_ppm.value, f.residual_ppm.se, f.noise_floor_ppm.value, f.noise_floor_ppm.se
     );
     for n in &f.notes {
         println!("note: {n}");
+    }
+    for w in &f.warnings {
+        println!("warning: {}", w.message);
     }
     println!("written: {} (record CRC {crc})", out.display());
 }

@@ -1,15 +1,17 @@
 //! `gyro-lab lockin`: the RLG lock-in rate of a fringe record by the exact
 //! harmonic relation (calibration/lockin.rs).
 
-use crate::calibration::lockin::lock_in;
-use crate::cli::args::Json;
-use crate::cli::output::print_json;
+use crate::calibration::lockin::{lock_in, LockIn};
+use crate::cli::args::{Json, OutOpt};
+use crate::cli::output::{print_json, write_report};
+use crate::cli::reports;
 use crate::data::fringe_file::FringeFile;
 use crate::error::LabError;
 use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("Directory to write report.html in")))]
 pub struct LockinArgs {
     /// Fringe file: `t_s`, `signal`, optional `signal_q`.
     #[arg(long)]
@@ -21,7 +23,17 @@ pub struct LockinArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub input_rate_dps: Option<f64>,
     #[command(flatten)]
+    pub out: OutOpt,
+    #[command(flatten)]
     pub json: Json,
+}
+
+/// JSON of `lockin`: the estimate and the report's path.
+#[derive(serde::Serialize)]
+struct LockinJson<'a> {
+    #[serde(flatten)]
+    r: &'a LockIn,
+    report: Option<String>,
 }
 
 pub fn run(a: &LockinArgs) -> Result<(), LabError> {
@@ -47,8 +59,24 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
         a.input_rate_dps,
     )
     .map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    let report = match &a.out.out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
+            let path = dir.join("report.html");
+            let name = a.data.display().to_string();
+            write_report(
+                &reports::lockin::report(&name, &f.t_s, &f.signal, &r),
+                &path,
+            )?;
+            Some(path)
+        }
+        None => None,
+    };
     if a.json.json {
-        print_json(&r)?;
+        print_json(&LockinJson {
+            r: &r,
+            report: report.map(|p| p.display().to_string()),
+        })?;
     } else {
         println!(
             "lock-in {:.6} deg/s (+-{:.6}), input rate {:.6} deg/s ({}), beat {:.3} Hz, rho {:.6}",
@@ -67,6 +95,18 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
             "published approximate formula on the same record: {:.6} deg/s",
             r.lock_in_approx_dps
         );
+        println!(
+            "relative one-sigma {:.4} % against the Cramer-Rao bound {:.4} % (Omega_I/Omega_L {:.1})",
+            100.0 * r.lock_in_rel_std,
+            100.0 * r.cramer_rao_rel,
+            r.rate_ratio
+        );
+        for w in &r.warnings {
+            println!("warning: {}", w.message);
+        }
+        if let Some(p) = report {
+            println!("report: {}", p.display());
+        }
     }
     Ok(())
 }

@@ -15,6 +15,7 @@ pub mod lockin;
 pub mod model_file;
 pub mod output;
 pub mod record;
+pub mod reports;
 pub mod run_inputs;
 pub mod simulate;
 

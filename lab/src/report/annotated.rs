@@ -55,6 +55,13 @@ where
             .filter(|p| p.0.is_finite() && p.1.is_finite())
             .collect();
         match s.style {
+            Style::Bands => {
+                // Full height: each point is a band's (x_lo, x_hi).
+                let yr = ch.y_range();
+                ch.draw_series(pts.iter().map(|&(a, b)| {
+                    Rectangle::new([(a, yr.start), (b, yr.end)], c.mix(0.18).filled())
+                }))?;
+            }
             Style::Line => {
                 ch.draw_series(LineSeries::new(pts, c.stroke_width(2)))?;
             }
@@ -110,6 +117,10 @@ fn legend(
                     area.draw(&PathElement::new(vec![(19, y), (25, y)], c.stroke_width(1)))
                 })?,
             Style::Points => area.draw(&Circle::new((19, y), 3, c.filled()))?,
+            Style::Bands => area.draw(&Rectangle::new(
+                [(8, y - 5), (30, y + 5)],
+                c.mix(0.4).filled(),
+            ))?,
         }
         area.draw(&Text::new(s.label.clone(), (38, y - 7), font.clone()))?;
         y += 20;

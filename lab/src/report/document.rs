@@ -3,13 +3,17 @@
 
 use super::plot::{self, Axes, Series};
 use super::text::esc;
+use super::verdict::Verdict;
 use std::fmt::Write as _;
 
-const CSS: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}\
+const CSS: &str =
+    "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}\
 table{border-collapse:collapse;margin:0.8em 0}td,th{border:1px solid #bbb;padding:3px 8px;\
 text-align:right}th{background:#eee}td:first-child,th:first-child{text-align:left}\
-figure{margin:1em 0}figcaption{font-size:0.9em;color:#555}p.note{color:#555;font-size:0.9em}";
+figure{margin:1em 0}figcaption{font-size:0.9em;color:#555}p.note{color:#555;font-size:0.9em}\
+p.verdict{background:#f4f7fb;border-left:4px solid #1f77b4;padding:0.6em 0.9em;line-height:1.45}\
+p.verdict.warn{border-left-color:#d62728}span.warning{color:#b00}";
 
 /// A report under construction.
 pub struct Report {
@@ -55,14 +59,31 @@ impl Report {
         self.body.push_str("</table>\n");
     }
 
-    /// A plot, drawn now as inline SVG.
+    /// The report's verdict: one paragraph, its numbers tagged with the
+    /// JSON keys they come from (`data-key`), its warnings marked.
+    pub fn verdict(&mut self, v: &Verdict) {
+        let class = if v.has_warnings() {
+            "verdict warn"
+        } else {
+            "verdict"
+        };
+        let _ = writeln!(self.body, "<p class=\"{class}\">{}</p>", v.html());
+    }
+
+    /// A plot, drawn now as inline SVG. The figure says what it plots:
+    /// its axes (`data-x`, `data-y`) and how many data points it draws
+    /// (`data-points`).
     pub fn plot(&mut self, axes: &Axes, series: &[Series], caption: &str) {
         self.figures += 1;
         let svg = plot::svg(axes, series);
         let _ = write!(
             self.body,
-            "<figure id=\"fig{}\">\n{svg}\n<figcaption>Figure {}. {}</figcaption>\n</figure>\n",
+            "<figure id=\"fig{}\" data-x=\"{}\" data-y=\"{}\" data-points=\"{}\">\n{svg}\n\
+             <figcaption>Figure {}. {}</figcaption>\n</figure>\n",
             self.figures,
+            esc(&axes.x_label),
+            esc(&axes.y_label),
+            plot::data_points(series),
             self.figures,
             esc(caption)
         );

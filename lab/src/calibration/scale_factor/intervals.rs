@@ -79,7 +79,13 @@ pub fn knee_intervals(
         let prof = |t: f64| {
             let mut k = c.knees.clone();
             k[j] = t;
-            golden(|l| m.sse(l, &k), (c.lag - 15.0).max(0.0), c.lag + 15.0, 14).1
+            golden(
+                |l| m.sse(l, c.degree, &k),
+                (c.lag - 15.0).max(0.0),
+                c.lag + 15.0,
+                14,
+            )
+            .1
         };
         let k = c.knees[j];
         let (ci_lo, ci_hi) =
@@ -99,6 +105,7 @@ pub fn knee_intervals(
 pub fn lag_interval(m: &Model, c: &Candidate, thr: f64, (lo, hi): (f64, f64)) -> (f64, f64) {
     let prof_lag = |l: f64| {
         let mut cand = Candidate {
+            degree: c.degree,
             knees: c.knees.clone(),
             lag: l,
             sse: 0.0,
@@ -110,7 +117,7 @@ pub fn lag_interval(m: &Model, c: &Candidate, thr: f64, (lo, hi): (f64, f64)) ->
             cand.knees[j] = golden(
                 |t| {
                     k[j] = t;
-                    m.sse(l, &k)
+                    m.sse(l, c.degree, &k)
                 },
                 a,
                 b,
@@ -118,7 +125,7 @@ pub fn lag_interval(m: &Model, c: &Candidate, thr: f64, (lo, hi): (f64, f64)) ->
             )
             .0;
         }
-        m.sse(l, &cand.knees)
+        m.sse(l, c.degree, &cand.knees)
     };
     profile_interval(prof_lag, c.lag, c.sse, thr, 0.5, (0.0, 1000.0))
 }

@@ -4,9 +4,12 @@
 //! plateaus; a knee is tested on the plateau points (BIC), its interval is
 //! where the points cannot place it.
 
+use super::families::{choose, Family, Scored};
 use super::input::SfInput;
-use super::residual::{window_rms_ppm, RESIDUAL_WINDOW_S};
+use super::residual::{noise_floor_ppm, window_rms_ppm, RESIDUAL_WINDOW_S};
 use super::result::{Est, FitMethod, Interval, Segment, SfFit, SfFitError};
+use super::tabulate::{firmware_error_ppm, Tabulation};
+use super::warnings;
 use crate::numerics::lsq::{wls, LsFit};
 use crate::numerics::search::CHI2_1_95;
 use gyro_coeffs::fog_scale_factor::{ScaleFactorTable, MAX_NODES};
@@ -225,8 +228,8 @@ fn plateau_segments(pts: &[Plateau]) -> Vec<Segment> {
 }
 
 /// The residual over 60 s means, each plateau's rows about its own line,
-/// ppm; and the number of rows used.
-fn plateau_residual(inp: &SfInput, groups: &[Vec<usize>]) -> (Est, usize) {
+/// ppm; its noise floor; and the number of rows used.
+fn plateau_residual(inp: &SfInput, groups: &[Vec<usize>]) -> (Est, Est, usize) {
     let mut err = vec![0.0; inp.t.len()];
     let mut used = 0;
     for (g, p) in groups
@@ -252,6 +255,7 @@ fn plateau_residual(inp: &SfInput, groups: &[Vec<usize>]) -> (Est, usize) {
             value: rms,
             se: rms_se,
         },
+        noise_floor_ppm(&inp.t, &w_rot, &err),
         used,
     )
 }
@@ -291,7 +295,30 @@ pub fn fit_multipoint(
     let sf: Vec<f64> = pts.iter().map(|p| p.sf_ppm.value).collect();
     let bias: Vec<f64> = pts.iter().map(|p| p.bias_dph.value).collect();
     let table = ScaleFactorTable::from_nodes(&nodes, &sf, &bias, 0.0);
-    let (residual_ppm, used) = plateau_residual(inp, groups);
+    let (residual_ppm, noise_floor, used) = plateau_residual(inp, groups);
+    // The knee test as the families' criterion: the line, or the hinge.
+    let mut scored: Vec<Scored> = bic
+        .iter()
+        .enumerate()
+        .map(|(k, &b)| Scored {
+            model: Family::of(1, k),
+            poly_degree: 1,
+            knees: k,
+            knees_c: knees.iter().take(k).map(|i| i.value).collect(),
+            sensor_lag_s: 0.0,
+            bic: b,
+            delta_bic: 0.0,
+        })
+        .collect();
+    let (_, families, margin) = choose(&mut scored);
+    let range = [nodes[0], nodes[np - 1]];
+    let warns = [
+        warnings::span(range),
+        warnings::residual(residual_ppm, noise_floor),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     let notes = vec![
         "multi-point: the table interpolates linearly between the plateaus; a knee between two \
          plateaus is only bracketed"
@@ -301,7 +328,11 @@ pub fn fit_multipoint(
     Ok((
         SfFit {
             method: FitMethod::MultiPoint,
+            // The table interpolates linearly between the plateaus.
+            model: Family::Knees,
+            degree: 0,
             knees,
+            polynomial: None,
             segments: plateau_segments(&pts),
             table,
             sensor_lag_s: None,
@@ -313,11 +344,25 @@ pub fn fit_multipoint(
                 .filter_map(|p| p.nonlinearity_ppm)
                 .max_by(|a, b| a.value.total_cmp(&b.value)),
             bic,
+            criteria: scored,
+            families,
+            criterion_margin: margin,
             noise_inflation: 1.0,
             residual_ppm,
-            range_c: [nodes[0], nodes[np - 1]],
+            noise_floor_ppm: noise_floor,
+            tabulation: Tabulation {
+                nodes: table.n,
+                spacing_c: nodes.windows(2).map(|w| w[1] - w[0]).collect(),
+                tolerance_ppm: 0.0,
+                max_error_ppm: firmware_error_ppm(&table, |t| table.eval(t).0),
+            },
+            range_c: range,
             rows_used: used,
+            duration_s: inp.t.last().copied().unwrap_or(0.0)
+                - inp.t.first().copied().unwrap_or(0.0),
             notes,
+            warnings: warns,
+            curve: None,
         },
         pts,
     ))

@@ -4,6 +4,9 @@
 
 use super::figures::{noise_floor_100s, std_of_means, std_se};
 use super::fit::{coefficient_se, fit_thermal, CubicModel, ThermalData};
+use super::warnings;
+use crate::calibration::scale_factor::validation::{flag_spans, FlagSpan};
+use crate::calibration::warning::Warning;
 use gyro_sp::rlg::{CoeffError, ThermalCoeffs};
 
 /// The averaging of the drift figures, s.
@@ -23,6 +26,18 @@ pub struct FitSummary {
     /// Standard error of each standard deviation above (same order).
     pub std_100s_se_dph: [f64; 4],
     pub cubic: CubicModel,
+    /// Rows and run length, s; the ranges of the monoblock sensor A and
+    /// the case sensor, degC.
+    pub rows: usize,
+    pub duration_s: f64,
+    pub mono_a_range_c: [f64; 2],
+    pub case_range_c: [f64; 2],
+    pub warnings: Vec<Warning>,
+    /// The improved model's residual and the cubic's, per row, deg/h.
+    #[serde(skip)]
+    pub residual_dph: Vec<f64>,
+    #[serde(skip)]
+    pub cubic_residual_dph: Vec<f64>,
 }
 
 /// Why a chamber run gives no coefficients the firmware takes.
@@ -48,6 +63,14 @@ impl std::fmt::Display for ThermalFitError {
     }
 }
 
+/// Smallest and largest of `v`.
+pub fn range(v: &[f64]) -> [f64; 2] {
+    v.iter()
+        .fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| {
+            [a.min(*x), b.max(*x)]
+        })
+}
+
 /// The drift of a run after the classic cubic `m` on the sensor A.
 pub fn cubic_residual(m: &CubicModel, d: &ThermalData) -> Vec<f64> {
     d.drift_dph
@@ -70,17 +93,46 @@ pub fn calibrate(d: &ThermalData) -> Result<FitSummary, ThermalFitError> {
         std_of_means(&d.t, &cubic_res, WINDOW_S),
         noise_floor_100s(&d.t, &d.drift_dph),
     ];
+    let se = coefficient_se(d, &c);
+    let std_se_v = stds.map(|x| std_se(x, &d.t, WINDOW_S));
+    let mut warns = se
+        .as_ref()
+        .map_or_else(Vec::new, |e| warnings::unresolved_terms(d, &c, e));
+    warns.extend(warnings::residual(
+        stds[1],
+        std_se_v[1],
+        stds[3],
+        std_se_v[3],
+    ));
     Ok(FitSummary {
         coefficients: c,
-        coefficient_se: coefficient_se(d, &c),
+        coefficient_se: se,
         raw_std_100s_dph: stds[0],
         residual_std_100s_dph: stds[1],
         cubic_std_100s_dph: stds[2],
         noise_floor_100s_dph: stds[3],
-        std_100s_se_dph: stds.map(|x| std_se(x, &d.t, WINDOW_S)),
+        std_100s_se_dph: std_se_v,
         cubic,
+        rows: d.t.len(),
+        mono_a_range_c: range(&d.a),
+        case_range_c: range(&d.case),
+        duration_s: d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0),
+        warnings: warns,
+        residual_dph: resid,
+        cubic_residual_dph: cubic_res,
     })
 }
+
+/// The temperatures a thermal fit saw (its coefficient file's `[fit]`
+/// table keeps them): monoblock sensor A and the case sensor, degC.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct CalibratedRange {
+    pub mono_a_c: [f64; 2],
+    pub case_c: [f64; 2],
+}
+
+/// A run this far outside the calibrated range is warned about, degC.
+pub const OUT_OF_RANGE_MARGIN_C: f64 = 0.5;
 
 #[derive(Debug, serde::Serialize)]
 pub struct CompensateSummary {
@@ -97,17 +149,67 @@ pub struct CompensateSummary {
     pub cubic_std_100s_dph: Option<f64>,
     pub coeffs_refused: bool,
     pub sensor_flags_seen: u8,
+    pub rows: usize,
+    pub duration_s: f64,
+    /// The fit's temperatures (null when the coefficient file does not
+    /// state them) and the spans of this run outside them by more than
+    /// [`OUT_OF_RANGE_MARGIN_C`] (`min_c`, `max_c`: monoblock sensor A).
+    pub calibrated_range: Option<CalibratedRange>,
+    pub out_of_range_spans: Vec<FlagSpan>,
+    pub warnings: Vec<Warning>,
+    /// The compensated drift per row, deg/h.
+    #[serde(skip)]
+    pub comp_drift_dph: Vec<f64>,
+}
+
+/// The rows' spans outside `r` (by more than the margin) on either sensor.
+fn outside(d: &ThermalData, r: &CalibratedRange) -> Vec<FlagSpan> {
+    let out = |x: f64, [lo, hi]: [f64; 2]| {
+        x < lo - OUT_OF_RANGE_MARGIN_C || x > hi + OUT_OF_RANGE_MARGIN_C
+    };
+    let flags: Vec<u8> =
+        d.a.iter()
+            .zip(&d.case)
+            .map(|(&a, &k)| u8::from(out(a, r.mono_a_c) || out(k, r.case_c)))
+            .collect();
+    flag_spans(&d.t, &flags, 1, &d.a)
+}
+
+fn outside_warning(spans: &[FlagSpan], r: &CalibratedRange) -> Option<Warning> {
+    if spans.is_empty() {
+        return None;
+    }
+    let secs: f64 = spans.iter().map(|s| s.to_s - s.from_s).sum();
+    let (lo, hi) = spans
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
+            (a.min(s.min_c), b.max(s.max_c))
+        });
+    Some(Warning::new(
+        "outside_calibrated_range",
+        format!(
+            "{secs:.0} s of the run in {} span(s) lay outside the temperatures the fit saw \
+             (monoblock A {:.1} .. {:.1} degC, case {:.1} .. {:.1} degC; here monoblock A {lo:.1} .. \
+             {hi:.1} degC): the model is extrapolated there",
+            spans.len(),
+            r.mono_a_c[0],
+            r.mono_a_c[1],
+            r.case_c[0],
+            r.case_c[1]
+        ),
+    ))
 }
 
 /// The figures of a compensated run: `comp` its compensated rate (deg/s),
 /// `flags` the sensor flags of each row, `cubic` a classic cubic fitted on
-/// another run (for comparison only).
+/// another run (for comparison only), `range` the temperatures the fit saw.
 pub fn compensation_summary(
     c: &ThermalCoeffs,
     d: &ThermalData,
     ref_rate_dps: &[f64],
     (comp, flags): (&[f64], &[u8]),
     cubic: Option<&CubicModel>,
+    range: Option<CalibratedRange>,
 ) -> CompensateSummary {
     let comp_drift: Vec<f64> = comp
         .iter()
@@ -118,16 +220,50 @@ pub fn compensation_summary(
     let comp_std = std_of_means(&d.t, &comp_drift, WINDOW_S);
     let cubic_std = cubic.map(|m| std_of_means(&d.t, &cubic_residual(m, d), WINDOW_S));
     let raw_std = std_of_means(&d.t, &d.drift_dph, WINDOW_S);
+    let (comp_se, floor_se) = (
+        std_se(comp_std, &d.t, WINDOW_S),
+        std_se(floor, &d.t, WINDOW_S),
+    );
+    let refused = c.check().is_err();
+    let flags_seen = flags.iter().fold(0, |x, f| x | f);
+    let mut warns: Vec<Warning> = warnings::residual(comp_std, comp_se, floor, floor_se)
+        .into_iter()
+        .collect();
+    if refused {
+        warns.push(Warning::new(
+            "coeffs_refused",
+            "the firmware's check refused the coefficients: the run was not compensated".into(),
+        ));
+    }
+    let spans = range.as_ref().map_or_else(Vec::new, |r| outside(d, r));
+    if let Some(r) = &range {
+        warns.extend(outside_warning(&spans, r));
+    }
+    if flags_seen != 0 {
+        warns.push(Warning::new(
+            "sensor_flagged",
+            format!(
+                "temperature sensor flags {flags_seen:#04x} were raised: a flagged sensor's last good \
+                 value was held"
+            ),
+        ));
+    }
     CompensateSummary {
         raw_std_100s_dph: raw_std,
         comp_std_100s_dph: comp_std,
         noise_floor_100s_dph: floor,
         raw_std_100s_se_dph: std_se(raw_std, &d.t, WINDOW_S),
-        comp_std_100s_se_dph: std_se(comp_std, &d.t, WINDOW_S),
-        noise_floor_100s_se_dph: std_se(floor, &d.t, WINDOW_S),
+        comp_std_100s_se_dph: comp_se,
+        noise_floor_100s_se_dph: floor_se,
         comp_over_floor: comp_std / floor,
         cubic_std_100s_dph: cubic_std,
-        coeffs_refused: c.check().is_err(),
-        sensor_flags_seen: flags.iter().fold(0, |x, f| x | f),
+        coeffs_refused: refused,
+        sensor_flags_seen: flags_seen,
+        rows: d.t.len(),
+        duration_s: d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0),
+        calibrated_range: range,
+        out_of_range_spans: spans,
+        warnings: warns,
+        comp_drift_dph: comp_drift,
     }
 }

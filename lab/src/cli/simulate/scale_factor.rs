@@ -8,6 +8,7 @@ use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
 use crate::sim::scale_factor_rig::{simulate, Direction, RigParams, SweepProfile, Test};
 use clap::{Args, ValueEnum};
+use gyro_sim::fog_thermal::MAX_KNEES;
 
 /// Chamber profiles of the continuous-rotation test, as the command line
 /// names them.
@@ -86,6 +87,25 @@ pub struct SimulateArgs {
     /// The same gyro without its knee.
     #[arg(long)]
     pub no_knee: bool,
+    /// Knee temperatures of the truth, degC (replacing the default 48),
+    /// with `--knee-slope-changes` (ppm/degC, one per knee).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        conflicts_with = "no_knee"
+    )]
+    pub knees_c: Vec<f64>,
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub knee_slope_changes: Vec<f64>,
+    /// Smooth curvature of the truth: `q (T - centre)^2 + c (T - centre)^3`
+    /// added to the scale-factor error, ppm/degC^2 and ppm/degC^3.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub quadratic_ppm_per_c2: f64,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub cubic_ppm_per_c3: f64,
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub curve_centre_c: f64,
     /// Angle random walk, deg/sqrt(h); bias instability, deg/h.
     #[arg(long, default_value_t = 0.005)]
     pub arw_dpsh: f64,
@@ -128,12 +148,25 @@ impl SimulateArgs {
 
     pub fn rig(&self) -> RigParams {
         let d = RigParams::default();
+        let mut truth = if self.no_knee {
+            d.truth.without_knees()
+        } else {
+            d.truth
+        };
+        if !self.knees_c.is_empty() {
+            truth.n_knees = self.knees_c.len().min(MAX_KNEES);
+            for (k, &t) in self.knees_c.iter().take(MAX_KNEES).enumerate() {
+                let ds = self.knee_slope_changes.get(k).copied().unwrap_or(6.0);
+                truth.knees[k] = (t, ds);
+            }
+        }
+        let truth = truth.curved(
+            self.quadratic_ppm_per_c2,
+            self.cubic_ppm_per_c3,
+            self.curve_centre_c,
+        );
         RigParams {
-            truth: if self.no_knee {
-                d.truth.without_knees()
-            } else {
-                d.truth
-            },
+            truth,
             arw_dpsh: self.arw_dpsh,
             bias_instability_dph: self.bias_instability_dph,
             tau_sensor_s: self.sensor_lag_s,
@@ -169,17 +202,39 @@ pub fn run(a: &SimulateArgs) -> Result<(), LabError> {
     for &r in &a.rates_dps {
         pos("rates-dps", r, 0.0, 1000.0)?;
     }
+    if a.knees_c.len() > MAX_KNEES {
+        return Err(LabError::Usage(format!(
+            "--knees-c: at most {MAX_KNEES} knees"
+        )));
+    }
+    for &t in &a.knees_c {
+        pos("knees-c", t, -55.0, 125.0)?;
+    }
+    for &ds in &a.knee_slope_changes {
+        pos("knee-slope-changes", ds.abs(), 0.0, 1000.0)?;
+    }
+    pos(
+        "quadratic-ppm-per-c2",
+        a.quadratic_ppm_per_c2.abs(),
+        0.0,
+        10.0,
+    )?;
+    pos("cubic-ppm-per-c3", a.cubic_ppm_per_c3.abs(), 0.0, 1.0)?;
+    pos("curve-centre-c", a.curve_centre_c, -55.0, 125.0)?;
     let run = simulate(&a.test(), &a.rig());
     let truth = a.rig().truth;
     let knees: Vec<f64> = truth.knees[..truth.n_knees].iter().map(|k| k.0).collect();
     let mut w = RunWriter::create(
         &a.out.out,
         &format!(
-            "gyro-lab simulate scale-factor: {:?} test, seed {}; truth: knees at {:?} degC, sensor lag {} s\n\
+            "gyro-lab simulate scale-factor: {:?} test, seed {}; truth: knees at {:?} degC, curvature {} ppm/degC^2 and {} ppm/degC^3 about {} degC, sensor lag {} s\n\
              {} is the coil sensor; {} and {} are the truth (not used by the fit)",
             a.test,
             a.seed.seed,
             knees,
+            truth.quad_ppm_per_c2,
+            truth.cubic_ppm_per_c3,
+            truth.curve_centre_c,
             a.sensor_lag_s,
             Column::Temp.name(),
             Column::TrueCoilTemp.name(),
