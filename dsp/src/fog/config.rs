@@ -64,6 +64,13 @@ pub struct FogParams {
     /// ADC reading with no light (detector dark output plus ADC offset), LSB per
     /// sample; the front end sits above zero so a dark fringe is not clipped.
     pub dark_lsb: f64,
+    /// Detector (front end) response time, s: at each modulation edge the
+    /// phase difference sweeps through the bright fringe, and the kept
+    /// samples still carry exp(-t/detector_tau_s) of that glitch. It adds a
+    /// DC the AGC would read as light (0.2 % at 7pi/8 with one of four
+    /// samples skipped); the error scale takes it out (docs/fog.md, "AGC and
+    /// the DC moment"). 0: an ideal detector.
+    pub detector_tau_s: f64,
 }
 
 impl Default for FogParams {
@@ -88,6 +95,7 @@ impl Default for FogParams {
             vibration_correction: true,
             nominal_dc_lsb: 8_000.0,
             dark_lsb: 1_024.0,
+            detector_tau_s: 0.15e-6,
         }
     }
 }
@@ -162,7 +170,9 @@ impl FogConfig {
             && finite_pos(p.tau_s)
             && finite_pos(p.closure_hz)
             && finite_pos(p.nominal_dc_lsb)
-            && p.dark_lsb.is_finite())
+            && p.dark_lsb.is_finite()
+            && p.detector_tau_s.is_finite()
+            && p.detector_tau_s >= 0.0)
         {
             return Err(ConfigError::Physical);
         }
@@ -209,8 +219,13 @@ impl FogConfig {
         );
         let dither =
             DitherConfig::new(p.dither_adc_codes, p.adc_bits, p.nominal_dc_lsb, p.phi0_rad);
-        let vibration = VibrationConfig::new(p.vibration_correction, p.phi0_rad, n_half)
-            .ok_or(ConfigError::VibrationCoeff)?;
+        let vibration = VibrationConfig::new(
+            p.vibration_correction,
+            p.phi0_rad,
+            n_half,
+            dither.half_width_rad(),
+        )
+        .ok_or(ConfigError::VibrationCoeff)?;
         let gain_loop =
             GainLoopConfig::new(p.gain_loop_gain, p.dac_codes_per_turn, p.phi0_rad, n_half);
 
@@ -233,8 +248,26 @@ impl FogConfig {
             (1.0, 0.0)
         };
         let slope_mean = sinc - cot_phi0 * cot_phi0 * r_sin;
+        // The detector's settling: sample i of a half period (t = i*tau/spp)
+        // reads level*(1 - e_i) + P0*e_i, e_i = exp(-t/detector_tau), P0 =
+        // 2A the bright fringe the edge swept through. The kept sum is then
+        // A*(1 + c)*(kept - e) + 2A*e (e the kept samples' sum of e_i), the
+        // slope A*sin(phi0)*(kept - e): the normalised error is short by
+        // 1 + 2e/((1 + c)(kept - e)), which the scale restores. Left in, it
+        // is a loop gain error the AGC's DC moment amplifies under
+        // vibration (by 1/(1 - excess share), docs/fog.md).
+        let settle: f64 = if p.detector_tau_s > 0.0 {
+            (p.skip_samples..p.samples_per_half)
+                .map(|i| (-(i as f64) * p.tau_s / p.samples_per_half as f64 / p.detector_tau_s).exp())
+                .sum()
+        } else {
+            0.0
+        };
+        let kept = kept_per_half as f64;
+        let settle_gain = 1.0 + 2.0 * settle / ((1.0 + c * sinc) * (kept - settle));
         let per_count = cot_half * PHASE_LSB_PER_RAD / n_half as f64 * (1.0 + c * sinc)
-            / ((1.0 + c) * slope_mean);
+            / ((1.0 + c) * slope_mean)
+            * settle_gain;
         // The closure scales the error by per_count * (2^32/H) / 2^16 with H
         // >= h0_min; below 2^31 its products with the closure's sums (below
         // 2^27) are single 32x32 multiplies. That needs the operating point's

@@ -22,6 +22,7 @@ pub mod faults;
 pub mod gain_loop;
 pub mod layout;
 pub mod lock;
+pub mod residual;
 mod modulator;
 pub mod scale_factor;
 pub mod vibration;
