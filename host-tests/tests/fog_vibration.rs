@@ -340,6 +340,7 @@ fn eps2_terms() {
     let (mut miss, mut err_sum, mut bias_sum) = (0.0, 0.0, 0.0);
     let (mut model_err, mut model_bias) = (0.0, 0.0);
     let mut cpt_sum = 0.0;
+    let mut rmax: f64 = 0.0;
     let (mut exact_err, mut exact_bias) = (0.0, 0.0);
     let (mut even_miss, mut odd_miss, mut odd_err, mut odd_bias) = (0.0, 0.0, 0.0, 0.0);
     for _ in 0..closures {
@@ -353,6 +354,7 @@ fn eps2_terms() {
         let y = err - bias;
         miss += y;
         cpt_sum += s.out.codes_per_turn_q8 as f64;
+        rmax = rmax.max((s.out.residual as f64 * lsb).abs());
         // The ideal closure: levels of delta_j = x + b*(j - (n-1)/2).
         let model = |x: f64, b: f64| {
             let nn = n as usize;
@@ -407,6 +409,7 @@ fn eps2_terms() {
     let m = closures as f64;
     println!("mean err {:.4e} mean bias {:.4e} mean miss {:.4e} rad ({:+.3} % of err)", err_sum / m, bias_sum / m, miss / m, miss / err_sum * 100.0);
     println!("exact halves: err {:.4e} ({:+.3} % vs sim) bias {:.4e} ({:+.3} % vs sim; miss {:+.3} %)", exact_err / m, (exact_err / err_sum - 1.0) * 100.0, exact_bias / m, (exact_bias / bias_sum - 1.0) * 100.0, (exact_err - exact_bias) / exact_err * 100.0);
+    println!("largest |residual| {rmax:.4} rad (sine {:.4})", rmax.sin());
     println!("codes per turn mean {:.4} (nominal {})", cpt_sum / m / 256.0, r.cfg.params.dac_codes_per_turn);
     println!("even miss {:+.4e} odd miss {:+.4e} odd err {:+.4e} odd bias {:+.4e} (rad, mean)", even_miss / m, odd_miss / m, odd_err / m, odd_bias / m);
     println!("ideal model: err {:.4e} ({:+.3} % vs sim) bias {:.4e} (miss {:+.3} %)", model_err / m, (model_err / err_sum - 1.0) * 100.0, model_bias / m, (model_err - model_bias) / model_err * 100.0);

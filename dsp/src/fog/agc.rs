@@ -138,10 +138,10 @@ impl Agc {
     /// residual, S the in-closure spread's share. With the levels' own
     /// amplitude (neg_sum = A*sin(phi0)*n*r, diff = A*sin(phi0)*n*d/2),
     /// `2E*A*sin(phi0)*n = neg_sum*(r + 3/2*(asin(r) - r)) + w*diff*d*(1 +
-    /// 3q/2)` to r^6 (0.02 % of E at r = 0.4), w = 2(n^2 - 1)/(3n^2),
+    /// 3q/2)` to r^6 (0.02 % of E at r = 0.37), w = 2(n^2 - 1)/(3n^2),
     /// q = r^2.
     /// |diff| < 2^27, |slope * spread| < 2^29 (weighted below 2^30), |neg_sum|
-    /// < 2^27, the moment's residual below 1.1 * 2^29: |m| < 2^58 and its
+    /// < 2^27, the moment's residual below 1.1 * 2^28: |m| < 2^58 and its
     /// high word below 2^26 (dropping the low word costs under 1e-4 of the
     /// DC), so 16 times it fits an i32.
     #[inline(always)]
@@ -150,10 +150,11 @@ impl Agc {
             self.valid = false;
             return;
         };
-        let nq = s.sine.nq;
-        // The spread's weight times 1 + 3q/2 (3q/2 < 0.93 in Q31; nq = -q).
+        // The spread's weight times 1 + 3q/2 = 1 - 9h (h = -q/6, Q32; |9h|
+        // < 0.24).
+        let h = s.sine.h;
         let w = s.slope.wrapping_mul(cfg.spread_q8);
-        let w = w - smmul(w << 1, nq + (nq >> 1));
+        let w = w - smmul(w, h + (h << 3));
         // r + 3/2*(asin(r) - r) (n_lift is minus the step to asin).
         let r_m = s.sine.r - s.sine.n_lift - (s.sine.n_lift >> 1);
         let m = s.diff as i64 * w as i64 + s.neg_sum as i64 * r_m as i64;
@@ -192,7 +193,7 @@ mod tests {
         neg_sum: 0,
         sine: Sine {
             r: 0,
-            nq: 0,
+            h: 0,
             n_lift: 0,
         },
     };

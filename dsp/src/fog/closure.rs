@@ -264,10 +264,12 @@ impl FogLoop {
             // Clipped samples still give the error's sign, so the main loop
             // keeps running through over-range (holding it could lock it
             // there); the gain loop, the correction and the AGC, which need
-            // true levels, pause. The correction and the AGC first, while
-            // the residual's sine is in registers.
+            // true levels, pause (the correction with a zero slope: no bias,
+            // its carried fraction kept, and no branch). The correction and
+            // the AGC first, while the residual's sine is in registers.
+            let slope_true = if adc_over_range { 0 } else { slope_q3 };
+            bias = self.vibration.update(&cfg.vibration, slope_true, &sine);
             if !adc_over_range {
-                bias = self.vibration.update(&cfg.vibration, slope_q3, &sine);
                 let spread = Spread {
                     diff,
                     // The slope in 2^8 LSB, saturated at +-2^20.

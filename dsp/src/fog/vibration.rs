@@ -19,9 +19,10 @@ use num_traits::float::Float;
 pub struct VibrationConfig {
     /// -(cot(phi0)/n_half) * 512*pi in Q[`COEFF_FRAC`]: the factor from the
     /// in-closure slope (2^-3 phase LSB) to u = -(cot(phi0)/n) * slope in
-    /// rad, Q31, by one `smmul`. Below 2^31 in magnitude.
+    /// rad, Q32, by one `smmul`. Below 2^31 in magnitude; 0 when the
+    /// correction is off (the update then returns 0 without a branch).
     pub coeff: i32,
-    /// Off: the update returns no bias.
+    /// The correction is on.
     pub enabled: bool,
 }
 
@@ -46,11 +47,15 @@ impl VibrationConfig {
             * core::f64::consts::PI
             * (1u64 << COEFF_FRAC) as f64;
         // NaN (phi0 of 0) is refused too.
-        if enabled && (coeff.is_nan() || coeff.abs() >= 1_073_741_824.0) {
+        if enabled && (coeff.is_nan() || coeff.abs() >= 2_147_483_647.0) {
             return None;
         }
         Some(Self {
-            coeff: coeff.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            coeff: if enabled {
+                coeff.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32
+            } else {
+                0
+            },
             enabled,
         })
     }
@@ -64,33 +69,30 @@ pub struct VibrationCorrection {
 }
 
 /// Fraction bits of the coefficient (see [`VibrationConfig::coeff`]).
-pub const COEFF_FRAC: u32 = 20;
+pub const COEFF_FRAC: u32 = 21;
 
 impl VibrationCorrection {
     /// Takes this closure's slope d (2^-3 phase LSB: the i32 range is +-0.37 rad,
     /// beyond which the loop is not tracking and the correction means
-    /// nothing) and its residual's sine ([`Sine`]: r saturated at +-pi/4,
-    /// nq = -r^2); returns the bias to subtract from the output phase, whole
-    /// phase LSB (the fraction is carried, no loss; |bias| < 2^29), or 0
-    /// when the correction is off.
+    /// nothing) and its residual's sine ([`Sine`]: r saturated at +-pi/8,
+    /// and its square); returns the bias to subtract from the output phase, whole
+    /// phase LSB (the fraction is carried, no loss; |bias| < 2^27), or 0
+    /// when the correction is off (coefficient 0: u, v and the carried
+    /// fraction stay 0).
     #[inline(always)]
     pub fn update(&mut self, cfg: &VibrationConfig, slope_q3: i32, s: &Sine) -> i32 {
-        if !cfg.enabled {
-            return 0;
-        }
-        // u = -(cot(phi0)/n) * d [rad], Q31: config keeps |coeff| < 2^30, and
-        // the slope's range makes |u| < 0.24.
+        // u = -(cot(phi0)/n) * d [rad], Q32: config keeps |coeff| < 2^31,
+        // and the slope's range makes |u| < 0.24.
         let u = smmul(slope_q3, cfg.coeff);
-        // v = u/(1 - q) to q^3 (Horner, Q31; smmul of two Q31 is Q30, hence
-        // the doubling; nq = -q): |v| < 0.24/(1 - 0.62) < 0.64. The dropped
-        // q^4 is 0.07 % of v at r = 0.4.
-        let v = u - (smmul(s.nq, u) << 1);
-        let v = u - (smmul(s.nq, v) << 1);
-        let v = u - (smmul(s.nq, v) << 1);
-        // bias = r * v, phase LSB in Q32: 2r (below 2^30) times v in Q31
-        // (|2r * v| < 2^60); the fraction below one LSB waits for the next
-        // closure.
-        let total = self.frac as i64 + (s.r << 1) as i64 * v as i64;
+        // v = u/(1 - q) to q^3 (Horner, Q32, -q in Q32): |v| < 0.24/(1 -
+        // 0.154) < 0.29. The dropped q^4 is 0.06 % of v at r = 0.37.
+        let nq = s.neg_q();
+        let v = u - smmul(nq, u);
+        let v = u - smmul(nq, v);
+        let v = u - smmul(nq, v);
+        // bias = r * v, phase LSB in Q32 (|r * v| < 2^57); the fraction
+        // below one LSB waits for the next closure.
+        let total = self.frac as i64 + s.r as i64 * v as i64;
         self.frac = total as u32;
         (total >> 32) as i32
     }
@@ -118,20 +120,20 @@ mod tests {
         c.update(cfg, slope, &Sine::new(r))
     }
 
-    /// The series stands for 1/(1 - r^2) to 0.03 % up to r = 0.4 rad (the
-    /// largest residual of the eps^2 envelope).
+    /// The series stands for 1/(1 - r^2) to 0.06 % up to r = 0.39 rad (the
+    /// residual's limit; the eps^2 envelope reaches 0.37).
     #[test]
     fn series_is_the_slope_compression() {
-        let q: f64 = 0.16;
+        let q: f64 = 0.39 * 0.39;
         let series = 1.0 + q * (1.0 + q * (1.0 + q));
-        assert!((series * (1.0 - q) - 1.0).abs() < 7e-4);
+        assert!((series * (1.0 - q) - 1.0).abs() < 6e-4);
     }
 
     /// Over both reference instruments and slopes and residuals across
     /// their ranges, the sum of the biases (the carried fraction makes it
     /// exact over many closures) equals the formula's: to 2e-7 of its size
     /// (the coefficient's and r^2's rounding), 16|r|/2^32 per closure for
-    /// the floored Q31 products that r multiplies, and the fraction still
+    /// the floored products that r multiplies, and the fraction still
     /// carried.
     #[test]
     fn correction_follows_its_formula() {
@@ -184,14 +186,14 @@ mod tests {
                 update(&mut b, &cfg, slope, at)
             );
         }
-        // The largest bias, at both ends, stays below 2^29 LSB.
+        // The largest bias, at both ends, stays below 2^27 LSB.
         for (slope, r) in [
             (i32::MAX, RESIDUAL_LIMIT - 1),
             (i32::MIN, -RESIDUAL_LIMIT),
             (i32::MIN, RESIDUAL_LIMIT - 1),
         ] {
             let mut c = VibrationCorrection::default();
-            assert!(update(&mut c, &cfg, slope, r).unsigned_abs() < 1 << 29);
+            assert!(update(&mut c, &cfg, slope, r).unsigned_abs() < 1 << 27);
         }
     }
 
