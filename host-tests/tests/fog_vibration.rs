@@ -297,11 +297,31 @@ fn eps2_diag() {
     let mut p = eps2_instrument(phi0, closure, lat);
     p.dither_adc_codes = env("DITHER", 240.0);
     p.detector_tau_s = env("FW_DET_TAU", det);
-    let mut r = rig(p, |o| {o.adc_bits = 16; o.detector_tau_s = det}, vibration(eps, freq));
+    p.gain_loop_gain = env("GLG", 0.05);
+    p.dac_codes_per_turn = env("CODES", 49_152.0) as u32;
+    let power = env("POWER", 1.0);
+    let delay = env("DELAY", 0.0);
+    let prof = if delay > 0.0 {
+        gyro_sim::Profile::new(&[
+            gyro_sim::Segment::Constant { rate: 0.0, duration: delay },
+            gyro_sim::Segment::Oscillation { offset: 0.0, eps_peak: eps * DEG, freq_hz: freq, duration: f64::INFINITY },
+        ])
+    } else {
+        vibration(eps, freq)
+    };
+    let mut r = rig(p, |o| {o.adc_bits = 16; o.detector_tau_s = det; o.peak_lsb *= power}, prof);
     let formula = r.cfg.predicted_vibration_drift((eps * DEG).powi(2) / 2.0) * DPH;
-    let d = vibration_drift(&mut r, freq, EPS2_SETTLE_CLOSURES, |d| d.seconds >= secs);
-    println!("formula {formula:.6} raw {:.6} ({:+.3} %) corrected {:.7} left {:+.3} % +- {:.3} gain {:.5}",
-        d.raw_dph, (d.raw_dph / formula - 1.0) * 100.0, d.corrected_dph, d.corrected_dph / formula * 100.0,
+    let chunk = env("CHUNK", 1e9);
+    let mut next = chunk;
+    let d = vibration_drift(&mut r, freq, EPS2_SETTLE_CLOSURES, |d| {
+        if d.seconds >= next {
+            println!("  {:.0} s: corrected {:.7} +- {:.7}", d.seconds, d.corrected_dph, d.corrected_se_dph);
+            next += chunk;
+        }
+        d.seconds >= secs
+    });
+    println!("formula {formula:.6} raw {:.6} ({:+.3} %) corrected {:.7} +- {:.7} left {:+.3} % +- {:.3} gain {:.5}",
+        d.raw_dph, (d.raw_dph / formula - 1.0) * 100.0, d.corrected_dph, d.corrected_se_dph, d.corrected_dph / formula * 100.0,
         d.corrected_se_dph / formula.abs() * 100.0, d.loop_gain);
 }
 

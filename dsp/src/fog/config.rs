@@ -223,7 +223,7 @@ impl FogConfig {
             p.vibration_correction,
             p.phi0_rad,
             n_half,
-            dither.half_width_rad(),
+            dither.mean_square(),
         )
         .ok_or(ConfigError::VibrationCoeff)?;
         let gain_loop =
@@ -231,23 +231,19 @@ impl FogConfig {
 
         // Residual per normalised demodulator count. With depth phi0 + r (the
         // dither) the error slope is A*sin(phi0 + r), which the closure scales
-        // by 1 - r*cot(phi0), and the DC A*(1 + cos(phi0 + r)). Over a uniform
-        // dither of half width w the mean slope is A*sin(phi0)*G, G = <cos r> -
-        // cot^2(phi0)*<r sin r> = sin(w)/w - cot^2(phi0)*(sin w - w cos w)/w,
-        // and the DC A*(1 + c*sin(w)/w) (c = cos phi0), so the unit-gain scale
-        // is cot(phi0/2)/n times (1 + c*sin(w)/w)/((1 + c)*G) (docs/fog.md,
+        // by 1 - r*cot(phi0), and the DC A*(1 + cos(phi0 + r)). Over the
+        // dither (triangular, [`DitherConfig::mean_cos`]) the mean slope is
+        // A*sin(phi0)*G, G = <cos r> - cot^2(phi0)*<r sin r>, and the DC
+        // A*(1 + c*<cos r>) (c = cos phi0), so the unit-gain scale is
+        // cot(phi0/2)/n times (1 + c*<cos r>)/((1 + c)*G) (docs/fog.md,
         // "Depth dither"). The residual's own spread moves the DC the same
         // way; the AGC's DC moment removes that.
         let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
         let cot_phi0 = 1.0 / p.phi0_rad.tan();
         let c = p.phi0_rad.cos();
         let w = dither.half_width_rad();
-        let (sinc, r_sin) = if w > 0.0 {
-            (w.sin() / w, (w.sin() - w * w.cos()) / w)
-        } else {
-            (1.0, 0.0)
-        };
-        let slope_mean = sinc - cot_phi0 * cot_phi0 * r_sin;
+        let sinc = dither.mean_cos();
+        let slope_mean = sinc - cot_phi0 * cot_phi0 * dither.mean_r_sin();
         // The detector's settling: sample i of a half period (t = i*tau/spp)
         // reads level*(1 - e_i) + P0*e_i, e_i = exp(-t/detector_tau), P0 =
         // 2A the bright fringe the edge swept through. The kept sum is then

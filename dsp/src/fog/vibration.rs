@@ -28,7 +28,7 @@ pub struct VibrationConfig {
 
 impl VibrationConfig {
     /// For depth `phi0_rad`, `n_half` half periods per closure and a depth
-    /// dither of half width `dither_rad` (uniform). `None` (with the
+    /// dither of mean square `dither_sq` (rad^2). `None` (with the
     /// correction on) when |cot(phi0)|/n_half is 0.637 or more: the
     /// coefficient would reach 2^30, and |u| (below 0.24 for the slope's
     /// range) with it the Q31 range of u/(1 - r^2).
@@ -36,11 +36,11 @@ impl VibrationConfig {
     /// The dither: a closure at depth phi0 + e has the coefficient
     /// cot(phi0 + e) and its levels are scaled back by 1 - e*cot(phi0)
     /// (closure.rs), so the drift's mean coefficient is cot(phi0) * (1 +
-    /// (1 + cot^2(phi0)) * <e^2>), <e^2> = w^2/3: 0.14 % at 7pi/8 with the
-    /// 16-bit ADC's 240 codes.
-    pub fn new(enabled: bool, phi0_rad: f64, n_half: usize, dither_rad: f64) -> Option<Self> {
+    /// (1 + cot^2(phi0)) * <e^2>): 0.07 % at 7pi/8 with the 16-bit ADC's
+    /// 240 codes (<e^2> = w^2/6, triangular).
+    pub fn new(enabled: bool, phi0_rad: f64, n_half: usize, dither_sq: f64) -> Option<Self> {
         let cot = 1.0 / phi0_rad.tan();
-        let dither = 1.0 + (1.0 + cot * cot) * dither_rad * dither_rad / 3.0;
+        let dither = 1.0 + (1.0 + cot * cot) * dither_sq;
         let coeff = -(cot / n_half as f64)
             * dither
             * 512.0
