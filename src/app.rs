@@ -11,6 +11,8 @@ use gyro_sp::frame::{AngleTotals, Frame, FrameBuilder, ResetCause};
 use gyro_sp::rlg::RlgWords;
 use heapless::spsc::{Producer, Queue};
 
+use crate::timing::{self, TimerRegs, TimingSpec, TIM1_CLK_HZ, TIM2_CLK_HZ};
+
 /// Frames the main loop has not yet sent (about 16 ms at 500 Hz).
 pub const FRAME_QUEUE_LEN: usize = 8;
 /// Frames from the closure interrupt to the main loop.
@@ -36,6 +38,29 @@ const _: () = assert!(
         && HALF_PERIODS <= MAX_HALF
         && SAMPLES_PER_HALF <= MAX_SAMPLES_PER_HALF
 );
+/// The hw board's sampling phase: TIM1 ticks (168 MHz, 5.95 ns) from a DAC
+/// word's update to the compare that starts the ADC's sample train, whose
+/// first sample of each half period is the skipped one. 233 ticks (1.387 us;
+/// the ADC holds 0.274 us later) is the middle of the chain's window
+/// 0.933..1.838 us (`timing::BOARD_CHAIN`, docs/timing.md): the first kept
+/// sample after a 2*pi reset's transient has settled, the last before the next
+/// edge. Trim it here (with the chain's measured delays).
+pub const SAMPLING_PHASE_TICKS: u32 = 233;
+/// TIM1 ticks per half period.
+pub const TIM1_TICKS_PER_HALF: u32 = TIM1_CLK_HZ / (CLOSURE_HZ * HALF_PERIODS as u32);
+const _: () = assert!(SAMPLING_PHASE_TICKS < TIM1_TICKS_PER_HALF);
+/// Both sampling timers' register values (`timing::timer_regs`; a timing the
+/// timers cannot make fails the build here).
+pub const SAMPLING_TIMERS: TimerRegs = match timing::timer_regs(&TimingSpec {
+    tim1_clk_hz: TIM1_CLK_HZ,
+    tim2_clk_hz: TIM2_CLK_HZ,
+    half_period_hz: CLOSURE_HZ * HALF_PERIODS as u32,
+    samples_per_half: SAMPLES_PER_HALF as u32,
+    phase_ticks: SAMPLING_PHASE_TICKS,
+}) {
+    Ok(r) => r,
+    Err(_) => panic!("the sampling timers cannot make this timing"),
+};
 
 /// The FOG parameters of both boards: the reference instrument with this
 /// layout, and `dac_latency` closures of DAC latency (the hw ping-pong: 1).

@@ -18,5 +18,6 @@ pub mod reset_cause;
 pub mod sampling;
 #[cfg(feature = "board")]
 pub mod stack;
+pub mod timing;
 #[cfg(feature = "qemu")]
 pub mod uart;

@@ -6,11 +6,12 @@
 //!
 //! Named PAC fields, because the HAL has no word for these: the circular
 //! half/complete DMA ping-pong, the ADC's analog watchdog, the SPI's 16-bit
-//! TX DMA with the hardware NSS output, and the timers' DMA request and
-//! trigger output.
+//! TX DMA with the hardware NSS output, and the sampling timers' master/slave
+//! link (register values from `timing.rs`).
 
-use crate::app::{ADC_PER_CLOSURE, CLOSURE_HZ, HALF_PERIODS};
+use crate::app::{ADC_PER_CLOSURE, CLOSURE_HZ, HALF_PERIODS, SAMPLING_TIMERS};
 use crate::overrun::{completion_time, judge, overtaken, periods_elapsed, BufferHalf, DmaState};
+use crate::timing::{oc1m, TimerRegs};
 use gyro_sp::fog::demod::{AWD_HIGH, AWD_LOW};
 use stm32f4::stm32f405 as pac;
 
@@ -211,11 +212,45 @@ impl Sampling {
     }
 }
 
-/// TIM1 requests one DAC word per update (UDE); TIM2's update is the ADC's
-/// trigger output (TRGO). Set before the HAL starts the timers.
-pub fn link_timers(tim1: &pac::tim1::RegisterBlock, tim2: &pac::tim2::RegisterBlock) {
-    tim1.dier().modify(|_, w| w.ude().set_bit());
-    tim2.cr2().modify(|_, w| w.mms().update());
+/// The sampling timers from one timebase (docs/timing.md, `timing.rs`): TIM1
+/// requests one DAC word per update (UDE) and, at the sampling phase after each
+/// update, its compare 1 raises OC1REF, its TRGO; that edge starts TIM2 (trigger
+/// mode on ITR0 = TIM1_TRGO), whose updates are the ADC's trigger. Register
+/// values: `app::SAMPLING_TIMERS`. Call on timers fresh from the HAL (reset
+/// through the RCC, not started); `start_timers` then starts both.
+pub fn configure_timers(tim1: &pac::tim1::RegisterBlock, tim2: &pac::tim2::RegisterBlock) {
+    const R: TimerRegs = SAMPLING_TIMERS;
+    // The RCC reset left both prescalers' active registers at 0, so PSC = 0
+    // needs no update event to load. Another prescaler would, and an update
+    // event is a DAC word request on TIM1 (UDE) and an ADC trigger on TIM2
+    // (its TRGO): the buffers' framing would slip by one.
+    const _: () = assert!(R.tim1.psc == 0 && R.tim2.psc == 0);
+    // TIM1 first, while TIM2 ignores its trigger.
+    tim1.psc().write(|w| w.psc().set(R.tim1.psc));
+    tim1.arr().write(|w| w.arr().set(R.tim1.arr));
+    tim1.cnt().write(|w| w.cnt().set(R.tim1.cnt));
+    tim1.ccr1().write(|w| w.ccr().set(R.tim1.ccr1));
+    // OC1REF low, then set by the first match and held: TRGO's one edge.
+    tim1.ccmr1_output()
+        .modify(|_, w| w.oc1m().set(oc1m::FORCE_INACTIVE));
+    tim1.ccmr1_output().modify(|_, w| w.oc1m().set(R.tim1.oc1m));
+    tim1.cr2().modify(|_, w| w.mms().set(R.tim1.mms));
+    tim1.dier().modify(|_, w| w.ude().bit(R.tim1.ude));
+    tim2.psc().write(|w| w.psc().set(R.tim2.psc));
+    tim2.arr().write(|w| w.arr().set(R.tim2.arr));
+    tim2.cnt().write(|w| w.cnt().set(R.tim2.cnt));
+    tim2.cr2().modify(|_, w| w.mms().set(R.tim2.mms));
+    // SAFETY: TS from timer_regs is ITR0 (0b000), a defined selection.
+    tim2.smcr().modify(|_, w| unsafe { w.ts().bits(R.tim2.ts) });
+    // Last: from here TIM1's TRGO starts TIM2.
+    tim2.smcr().modify(|_, w| w.sms().set(R.tim2.sms));
+}
+
+/// Starts the sampling: TIM1 counts (first update, DAC word 0, one tick
+/// later); its compare starts TIM2 at the sampling phase. No instruction
+/// timing enters the phase.
+pub fn start_timers(tim1: &pac::tim1::RegisterBlock) {
+    tim1.cr1().modify(|_, w| w.cen().set_bit());
 }
 
 /// TIM4 encoder inputs: digital filter of 8 samples at fCK_INT on both

@@ -8,13 +8,19 @@
 //!   cumulative angle words back into each frame's increments (a lost frame
 //!   loses no angle: the next one's increment spans the gap);
 //! - [`summary`]: what a record held (frames, errors, lost frames, faults);
-//! - [`rows`]: the FOG and RLG run-file rows.
+//! - [`rows`]: the FOG and RLG run-file rows;
+//! - [`recorder`]: a record on disk as bytes arrive (raw capture, rows
+//!   flushed every half second), merged with a [`reference`].
 
 pub mod decode;
+pub mod recorder;
+pub mod reference;
 pub mod rows;
 pub mod scales;
 pub mod summary;
 
 pub use decode::{Decoded, Decoder, StreamError};
+pub use recorder::{RecordError, Recorder};
+pub use reference::{RateLog, Reference};
 pub use scales::Scales;
 pub use summary::Summary;

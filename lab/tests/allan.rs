@@ -8,8 +8,10 @@
 mod common;
 use common::lab;
 
-use gyro_lab::allan::bench::{record, SAMPLES, SCENARIOS, TAU0_S};
-use gyro_lab::allan::{analyse, terms};
+use gyro_lab::bench::allan::{SAMPLES, SCENARIOS, TAU0_S};
+use gyro_lab::noise::analysis::analyse;
+use gyro_lab::noise::terms;
+use gyro_lab::sim::noise_run::record;
 
 #[test]
 fn known_terms_recovered_and_absent_ones_not_reported() {

@@ -5,10 +5,11 @@
 mod common;
 use common::{json, lab};
 
-use gyro_lab::discover::bench::{draw, trial};
-use gyro_lab::discover::trials::TestProfile;
-use gyro_lab::effects::{Effect, GyroKind};
-use gyro_lab::model::Model;
+use gyro_lab::bench::discover_trials::{draw, trial, TrialKind};
+use gyro_lab::model::effects::Effect;
+use gyro_lab::model::gyro_kind::GyroKind;
+use gyro_lab::model::gyro_model::Model;
+use gyro_lab::sim::model_run::TestProfile;
 use rand_core::SeedableRng;
 
 fn dir(name: &str) -> std::path::PathBuf {
@@ -144,7 +145,7 @@ fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
         let mut truth = known.clone();
         truth.push(h.clone());
         let o = trial(
-            e.name(),
+            TrialKind::Single(e),
             p,
             &model_of(p.gyro(), truth),
             &model_of(p.gyro(), known),
@@ -157,7 +158,7 @@ fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
     let (p, h, mut known) = draw(Effect::ThermalDifference, &mut rng);
     known.push(h);
     let m = model_of(p.gyro(), known);
-    let o = trial("nothing", p, &m, &m, &[], 601);
+    let o = trial(TrialKind::NothingMissing, p, &m, &m, &[], 601);
     assert!(o.named.is_empty() && o.ambiguous.is_empty(), "{o:?}");
     // Two hidden.
     let hidden = vec![
@@ -165,7 +166,7 @@ fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
         draw(Effect::ScaleFactorError, &mut rng).1,
     ];
     let o = trial(
-        "two",
+        TrialKind::TwoHidden,
         TestProfile::Table,
         &model_of(GyroKind::Fog, hidden.clone()),
         &model_of(GyroKind::Fog, vec![]),
@@ -176,7 +177,7 @@ fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
     // Collinear by construction: a scale-factor error at one rate is a bias.
     let h = draw(Effect::ScaleFactorError, &mut rng).1;
     let o = trial(
-        "collinear",
+        TrialKind::Collinear,
         TestProfile::ConstantRate,
         &model_of(GyroKind::Fog, vec![h.clone()]),
         &model_of(GyroKind::Fog, vec![]),
@@ -186,7 +187,7 @@ fn every_effect_hidden_once_nothing_and_pairs_and_collinear() {
     assert!(o.named.is_empty(), "{o:?}");
     let g = &o.ambiguous[0];
     assert!(
-        g.contains(&"bias") && g.contains(&"scale_factor_error"),
+        g.contains(&Effect::Bias) && g.contains(&Effect::ScaleFactorError),
         "{o:?}"
     );
 }

@@ -5,12 +5,15 @@
 mod common;
 use common::lab;
 
-use gyro_lab::scale_factor::bench::{continuous_fit_test, multipoint_test, validation_test};
-use gyro_lab::scale_factor::sim::{simulate, RigParams, Run};
-use gyro_lab::scale_factor::{compensate_rows, fit, fit_run_data};
+use gyro_lab::bench::scale_factor::{continuous_fit_test, multipoint_test, validation_test};
+use gyro_lab::calibration::scale_factor::compensation::compensate_rows;
+use gyro_lab::calibration::scale_factor::fit::fit;
+use gyro_lab::calibration::scale_factor::input::{prepare, SfInput};
+use gyro_lab::calibration::scale_factor::residual::window_rms_ppm;
+use gyro_lab::sim::scale_factor_rig::{simulate, RigParams, Run};
 
-fn input(run: &Run) -> fit::SfInput {
-    fit::prepare(&run.t_s, &run.ref_rate_dps, &run.rate_dps, &run.temp_c)
+fn input(run: &Run) -> SfInput {
+    prepare(&run.t_s, &run.ref_rate_dps, &run.rate_dps, &run.temp_c)
 }
 
 fn rms_ppm(run: &Run, rate: &[f64]) -> f64 {
@@ -19,16 +22,16 @@ fn rms_ppm(run: &Run, rate: &[f64]) -> f64 {
         .zip(&run.ref_rate_dps)
         .map(|(y, w)| y - w)
         .collect();
-    fit::window_rms_ppm(&run.t_s, &run.ref_rate_dps, &err, 60.0).0
+    window_rms_ppm(&run.t_s, &run.ref_rate_dps, &err, 60.0).0
 }
 
 #[test]
 fn continuous_rotation_finds_the_knee_and_compensates_another_run() {
     let rig = RigParams::default();
-    let f = fit_run_data(&input(&simulate(&continuous_fit_test(), &rig)))
+    let f = fit(&input(&simulate(&continuous_fit_test(), &rig)))
         .unwrap()
         .0;
-    assert_eq!(f.method, "continuous");
+    assert_eq!(f.method.to_string(), "continuous");
     assert_eq!(f.knees.len(), 1, "{:?}", f.knees);
     let k = f.knees[0];
     let truth = rig.truth.knees[0].0;
@@ -66,7 +69,7 @@ fn no_knee_is_fitted_with_no_knee() {
         seed: 5,
         ..RigParams::default()
     };
-    let f = fit_run_data(&input(&simulate(&continuous_fit_test(), &rig)))
+    let f = fit(&input(&simulate(&continuous_fit_test(), &rig)))
         .unwrap()
         .0;
     assert!(f.knees.is_empty(), "{:?} (BIC {:?})", f.knees, f.bic);
@@ -79,8 +82,8 @@ fn multipoint_brackets_the_knee_and_measures_asymmetry() {
         seed: 3,
         ..RigParams::default()
     };
-    let (f, plateaus) = fit_run_data(&input(&simulate(&multipoint_test(), &rig))).unwrap();
-    assert_eq!(f.method, "multi-point");
+    let (f, plateaus) = fit(&input(&simulate(&multipoint_test(), &rig))).unwrap();
+    assert_eq!(f.method.to_string(), "multi-point");
     let plateaus = plateaus.unwrap();
     assert_eq!(plateaus.len(), 5);
     // Each plateau's scale factor is the truth's at its temperature.

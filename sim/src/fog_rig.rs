@@ -93,7 +93,10 @@ where
         }
         let ns = self.cfg.n_samples;
         let (dac, adc, sagnac) = (&self.dac[0][..n], &mut self.adc[..ns], &self.sagnac[..n]);
-        self.adc_over_range = self.optics.run_step(dac, sagnac, adc);
+        // The next closure's first word: known here only with the DAC latency's
+        // ping-pong (the optics' chain may sample past the closure's last edge).
+        let next = (self.cfg.params.dac_latency != 0).then_some(self.dac[1][0]);
+        self.adc_over_range = self.optics.run_step_next(dac, next, sagnac, adc);
         sum / F::from(n).unwrap_or(F::one())
     }
 

@@ -13,7 +13,7 @@ pub mod profile;
 pub mod rlg_rig;
 pub mod vibration_drift;
 
-pub use fog_optics::{FogOptics, OpticsParams};
+pub use fog_optics::{Chain, FogOptics, OpticsParams};
 pub use fog_rig::FogRig;
 pub use fog_thermal::{CoilThermal, ScaleFactorTruth};
 pub use noise::{NoiseParams, RateNoise};

@@ -3,7 +3,8 @@
 //!
 //! - Clocks: 8 MHz HSE -> PLL -> 168 MHz core, APB2 84 MHz, APB1 42 MHz.
 //! - Detector: ADC1 on PA0, triggered by TIM2 TRGO at 800 kHz (4 samples per
-//!   5 us half period), DMA2 stream 0 circular over two closures; the
+//!   5 us half period; TIM2 is started by TIM1's compare at the sampling
+//!   phase, docs/timing.md), DMA2 stream 0 circular over two closures; the
 //!   half/complete interrupt runs the closure task on the closure just
 //!   sampled (`sampling.rs`).
 //! - Modulator: external 16-bit DAC on SPI1 (PA5 SCK, PA7 MOSI, PA4 NSS); TIM1
@@ -44,6 +45,7 @@ use gyro_fw::app::{
 use gyro_fw::i2c::I2c1;
 use gyro_fw::reset_cause::{reset_cause, HARD_FAULT_MARK};
 use gyro_fw::sampling::{self, AdcBuffer, DacBuffer, Sampling};
+use gyro_fw::timing;
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig, FogLoop};
 use gyro_sp::frame::{Frame, FrameBuilder, ResetCause};
@@ -75,11 +77,6 @@ const RLG_COUNTS_PER_DEG: f64 = 8_000.0;
 /// derivative for the lag lead is a quieter one (its noise scales as
 /// 1/sqrt(period)).
 const COIL_EVERY: u32 = 10;
-/// Half-period rate (TIM1, one DAC word each) and ADC rate (TIM2).
-const HALF_PERIOD_HZ: u32 = CLOSURE_HZ * HALF_PERIODS as u32;
-const ADC_HZ: u32 = CLOSURE_HZ * ADC_PER_CLOSURE as u32;
-/// Timer clocks (APB x2) divide exactly into both rates.
-const _: () = assert!(168_000_000 % HALF_PERIOD_HZ == 0 && 84_000_000 % ADC_HZ == 0);
 
 /// Readings from the idle loop to the RLG update task.
 type TempQueue = Queue<Temperatures, 2>;
@@ -278,10 +275,17 @@ mod app {
             cx.local.adc_buf,
             dac_buf,
         );
-        let mut tim1 = dp.TIM1.counter_hz(&mut rcc);
-        let mut tim2 = dp.TIM2.counter_hz(&mut rcc);
-        // SAFETY: the DMA request and trigger bits, which the HAL never writes.
-        sampling::link_timers(unsafe { &*pac::TIM1::ptr() }, unsafe { &*pac::TIM2::ptr() });
+        let tim1 = dp.TIM1.counter_hz(&mut rcc);
+        let tim2 = dp.TIM2.counter_hz(&mut rcc);
+        // The sampling timers' registers were computed for these clocks.
+        if rcc.clocks.timclk2().raw() != timing::TIM1_CLK_HZ
+            || rcc.clocks.timclk1().raw() != timing::TIM2_CLK_HZ
+        {
+            reset()
+        }
+        // SAFETY: the HAL's handles (kept, never started) reset both timers;
+        // only these register writes configure them.
+        sampling::configure_timers(unsafe { &*pac::TIM1::ptr() }, unsafe { &*pac::TIM2::ptr() });
 
         let (tx, frames) = cx.local.frame_queue.split();
         let (words, rlg_words) = cx.local.rlg_queue.split();
@@ -300,12 +304,11 @@ mod app {
         let mut watchdog = IndependentWatchdog::new(dp.IWDG);
         watchdog.start(100.millis());
 
-        // Both sampling timers together, so DAC and ADC half periods stay
-        // aligned; interrupts are enabled when init returns.
-        if tim1.start(HALF_PERIOD_HZ.Hz()).is_err()
-            || tim2.start(ADC_HZ.Hz()).is_err()
-            || rlg_timer.start(RLG_HZ.Hz()).is_err()
-        {
+        // The sampling from one timebase: TIM1 starts, its compare starts TIM2
+        // at the sampling phase; interrupts are enabled when init returns.
+        // SAFETY: CEN of the timer configured above.
+        sampling::start_timers(unsafe { &*pac::TIM1::ptr() });
+        if rlg_timer.start(RLG_HZ.Hz()).is_err() {
             reset()
         }
         defmt::info!(

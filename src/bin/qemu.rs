@@ -743,6 +743,14 @@ fn fail() -> ! {
     }
 }
 
+/// A hard fault under QEMU: log where, then leave with a failure status
+/// (the hw board resets instead and says so in its first frame).
+#[cortex_m_rt::exception]
+unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::error!("HardFault at pc {=u32:#x}, lr {=u32:#x}", ef.pc(), ef.lr());
+    fail()
+}
+
 /// Safe path: log, then leave QEMU with a failure status (the host test sees it).
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {

@@ -1,14 +1,15 @@
 //! Decoding of the firmware's UART frames into a run file, and the summary.
 
 use anyhow::{Context, Result};
-use gyro_frames::rows::{fog_rates, RunWriter};
-use gyro_frames::{Decoded, Decoder, Scales, Summary};
+use gyro_frames::rows::fog_rates;
+use gyro_frames::{Decoded, Decoder, RateLog, Recorder, Reference, Scales, Summary};
 use gyro_sim::profile::qemu_demo;
 use gyro_sim::ChamberParams;
 use gyro_sp::fog::scale_factor::FogTempFlags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::Frame;
 use gyro_sp::rlg::RlgFlags;
+use std::io::Write;
 use std::path::Path;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -108,21 +109,62 @@ pub fn analyse(path: &Path) -> Result<Report> {
     })
 }
 
-/// The run files, FOG and RLG, through the same row writer as `gyro-lab
-/// record` (docs/interfaces.md run-file columns and the board's).
-pub fn write_run_files(r: &Report, fog: &Path, rlg: &Path) -> Result<()> {
-    let scales = Scales::new(&r.cfg, ChamberParams::default().counts_per_deg);
-    let mut w = RunWriter::new(
-        std::io::BufWriter::new(std::fs::File::create(fog)?),
-        std::io::BufWriter::new(std::fs::File::create(rlg)?),
-        scales,
-        "gyro-fw under qemu-system-arm (netduinoplus2), built-in profile; RLG in a simulated chamber at 20 degC",
+/// The reference of the QEMU run as a rate log: the built-in profile
+/// sampled every 10 us (two half periods), written to `path` as
+/// `t_s,ref_rate_dps` (the `--reference` file `gyro-lab record` takes),
+/// and returned.
+pub fn write_reference(path: &Path) -> Result<RateLog> {
+    let (profile, _) = qemu_demo::<f64>();
+    let dt = 10e-6;
+    let n = (profile.total_duration() / dt).ceil() as usize + 2;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    let r: Vec<f64> = t.iter().map(|&t| profile.rate_at(t) / DEG).collect();
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(
+        w,
+        "# the qemu firmware's built-in rate profile, every 10 us"
     )?;
-    for row in &r.rows {
-        w.row(&row.decoded, row.ref_rate / DEG)?;
+    writeln!(w, "t_s,ref_rate_dps")?;
+    for (t, r) in t.iter().zip(&r) {
+        writeln!(w, "{t:.6},{r:.12}")?;
     }
     w.flush()?;
-    Ok(())
+    drop(w);
+    // Read back as `gyro-lab record --reference` reads it, so both paths
+    // hold the very same numbers.
+    let text = std::fs::read_to_string(path)?;
+    let (mut t, mut r) = (vec![], vec![]);
+    for line in text.lines().skip(2) {
+        let (a, b) = line.split_once(',').context("reference row")?;
+        t.push(a.parse()?);
+        r.push(b.parse()?);
+    }
+    RateLog::new(t, r, 0.0).map_err(|e| anyhow::anyhow!("reference log: {e:?}"))
+}
+
+/// The run files of a capture, through the recorder `gyro-lab record`
+/// uses (same decoder, same rows): `dir/fog.csv`, `dir/rlg.csv` and
+/// `dir/raw.bin`.
+/// Also returns the FOG angle (deg) and RLG counts over the record.
+pub fn record_capture(
+    capture: &Path,
+    dir: &Path,
+    reference: RateLog,
+) -> Result<(Summary, (f64, i64))> {
+    let bytes = std::fs::read(capture).with_context(|| format!("reading {}", capture.display()))?;
+    let cfg = FogConfig::new(FogParams::default()).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let scales = Scales::new(&cfg, ChamberParams::default().counts_per_deg);
+    let mut rec = Recorder::create(
+        dir,
+        scales,
+        Reference::Log(reference),
+        "gyro-fw under qemu-system-arm (netduinoplus2), built-in profile; RLG in a simulated chamber at 20 degC",
+    )
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    rec.push(&bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let angles = rec.angles();
+    let summary = rec.finish().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok((summary, angles))
 }
 
 /// Per segment, after 20 ms settling: mean and RMS of the final output

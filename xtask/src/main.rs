@@ -2,6 +2,7 @@
 //! what it needs (thumbv7em target, qemu-system-arm, flip-link, defmt-print).
 
 mod frames;
+mod record_test;
 mod setup;
 
 use anyhow::{bail, Context, Result};
@@ -16,6 +17,8 @@ fn main() {
         Some("qemu") => qemu_cmd(),
         Some("test") => test_cmd(),
         Some("bench") => bench_cmd(),
+        // The board-to-lab tests alone (part of `test`).
+        Some("record-test") => record_test_cmd(),
         _ => {
             eprintln!("usage: cargo xtask <qemu|test|bench>");
             std::process::exit(2);
@@ -191,13 +194,26 @@ fn qemu_cmd() -> Result<()> {
     setup::ensure_all()?;
     let run = run_qemu()?;
     let report = frames::analyse(&run.frames_path)?;
-    let csv = root().join("runs").join("qemu-fog.csv");
-    let rlg_csv = root().join("runs").join("qemu-rlg.csv");
-    frames::write_run_files(&report, &csv, &rlg_csv)?;
+    let dir = record_qemu_run(&run)?;
     frames::print_summary(&report);
-    println!("run file: {}", csv.display());
-    println!("RLG run file: {}", rlg_csv.display());
+    println!("run file: {}", dir.join("fog.csv").display());
+    println!("RLG run file: {}", dir.join("rlg.csv").display());
     Ok(())
+}
+
+/// The QEMU run's capture through the recorder into runs/qemu/, against
+/// the built-in profile (runs/qemu-reference.csv); the clean angles in
+/// runs/qemu/angles.json.
+fn record_qemu_run(run: &QemuRun) -> Result<PathBuf> {
+    let runs = root().join("runs");
+    let reference = frames::write_reference(&runs.join("qemu-reference.csv"))?;
+    let dir = runs.join("qemu");
+    let (_, (fog_deg, rlg_counts)) = frames::record_capture(&run.frames_path, &dir, reference)?;
+    std::fs::write(
+        dir.join("angles.json"),
+        serde_json::json!({ "fog_angle_deg": fog_deg, "rlg_counts": rlg_counts }).to_string(),
+    )?;
+    Ok(dir)
 }
 
 fn test_cmd() -> Result<()> {
@@ -219,10 +235,10 @@ fn test_cmd() -> Result<()> {
     run(cargo().args(["test", "--workspace", "--profile", "host-test"]))?;
     build_firmware("hw")?;
     // Tests of the firmware under QEMU.
-    let run = run_qemu()?;
-    let report = frames::analyse(&run.frames_path)?;
+    let qrun = run_qemu()?;
+    let report = frames::analyse(&qrun.frames_path)?;
     frames::print_summary(&report);
-    let checks = frames::qemu_checks(&report, &run.log);
+    let checks = frames::qemu_checks(&report, &qrun.log);
     let failed = checks.iter().filter(|c| !c.1).count();
     for (name, ok, detail) in &checks {
         println!(
@@ -233,6 +249,32 @@ fn test_cmd() -> Result<()> {
     println!("qemu: {} passed, {} failed", checks.len() - failed, failed);
     if failed > 0 {
         bail!("{failed} firmware test(s) under QEMU failed");
+    }
+    record_tests(&qrun)
+}
+
+/// `cargo xtask record-test`: the QEMU run and the board-to-lab tests.
+fn record_test_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    let qrun = run_qemu()?;
+    record_tests(&qrun)
+}
+
+/// The board-to-lab path: QEMU's USART on a pty read by `gyro-lab record`,
+/// then through a relay that damages the stream.
+fn record_tests(qrun: &QemuRun) -> Result<()> {
+    let clean = record_qemu_run(qrun)?;
+    run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
+    let checks = record_test::run(&qrun.elf, &clean, &root().join("runs/qemu-reference.csv"))?;
+    let failed = checks.iter().filter(|c| !c.1).count();
+    for (name, ok, detail) in &checks {
+        println!(
+            "record test {name} ... {} ({detail})",
+            if *ok { "ok" } else { "FAILED" }
+        );
+    }
+    if failed > 0 {
+        bail!("{failed} record test(s) failed");
     }
     Ok(())
 }

@@ -114,27 +114,24 @@ fn draw<X, Y>(
     xs: X,
     ys: Y,
     series: &[Series],
-) -> Result<(), String>
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let e = |e: &dyn std::fmt::Display| e.to_string();
     let mut ch = ChartBuilder::on(root)
         .margin(12)
         .caption(&axes.title, ("sans-serif", 18))
         .x_label_area_size(45)
         .y_label_area_size(80)
-        .build_cartesian_2d(xs, ys)
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d(xs, ys)?;
     ch.configure_mesh()
         .x_desc(axes.x_label.as_str())
         .y_desc(axes.y_label.as_str())
         .label_style(("sans-serif", 13))
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     for s in series {
         let c = PALETTE[s.color % PALETTE.len()];
         let pts: Vec<(f64, f64)> = s
@@ -148,14 +145,12 @@ where
         };
         match s.style {
             Style::Line => {
-                ch.draw_series(LineSeries::new(pts, c.stroke_width(2)))
-                    .map_err(|x| e(&x))?
+                ch.draw_series(LineSeries::new(pts, c.stroke_width(2)))?
                     .label(s.label.as_str())
                     .legend(legend(c));
             }
             Style::Dashed => {
-                ch.draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(1)))
-                    .map_err(|x| e(&x))?
+                ch.draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(1)))?
                     .label(s.label.as_str())
                     .legend(legend(c));
             }
@@ -169,11 +164,9 @@ where
                             .map(|(&(x, y), &(lo, hi))| {
                                 ErrorBar::new_vertical(x, lo, y, hi, c.stroke_width(1), 6)
                             }),
-                    )
-                    .map_err(|x| e(&x))?;
+                    )?;
                 }
-                ch.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
-                    .map_err(|x| e(&x))?
+                ch.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))?
                     .label(s.label.as_str())
                     .legend(move |(x, y)| Circle::new((x + 9, y), 3, c.filled()));
             }
@@ -183,9 +176,8 @@ where
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))
+        .draw()?;
+    root.present()
 }
 
 /// One plot as an SVG element.
@@ -211,6 +203,9 @@ pub fn svg(axes: &Axes, series: &[Series]) -> String {
     };
     match result {
         Ok(()) => out,
-        Err(e) => format!("<p>(plot not drawn: {})</p>", super::esc(&e)),
+        Err(e) => format!(
+            "<p>(plot not drawn: {})</p>",
+            super::text::esc(&e.to_string())
+        ),
     }
 }

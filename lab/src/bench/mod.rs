@@ -1,0 +1,10 @@
+//! The estimators against the simulators' truth, over seeds: lock-in
+//! (lockin.rs), scale factor (scale_factor.rs), Allan terms and speed
+//! (allan.rs), discovery (discover_trials.rs, discover_summary.rs). Each
+//! returns its figures; the bench command prints them.
+
+pub mod allan;
+pub mod discover_summary;
+pub mod discover_trials;
+pub mod lockin;
+pub mod scale_factor;

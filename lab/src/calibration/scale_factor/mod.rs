@@ -1,0 +1,25 @@
+//! FOG scale factor over temperature from a calibration run (docs/fog.md).
+//!
+//! Model, per sample: `y - w = w * s(T) + b(T)`, with w the reference rate,
+//! y the output (nominal scale factor), s the scale-factor error (relative),
+//! b the bias. T is the coil temperature, estimated from the coil sensor by
+//! the firmware's own blocks as `T_sensor + lag * dT_sensor/dt` (input.rs).
+//!
+//! - Continuous rotation (continuous.rs, on the model of
+//!   continuous_model.rs over the bins of bins.rs, with the intervals of
+//!   intervals.rs).
+//! - Multi-point (multipoint.rs).
+//!
+//! fit.rs chooses between them; compensation.rs applies a table as the
+//! firmware does; residual.rs is the figure both are judged by.
+
+pub mod bins;
+pub mod compensation;
+pub mod continuous;
+pub mod continuous_model;
+pub mod fit;
+pub mod input;
+pub mod intervals;
+pub mod multipoint;
+pub mod residual;
+pub mod result;

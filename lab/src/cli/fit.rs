@@ -1,0 +1,254 @@
+//! `gyro-lab fit thermal` and `gyro-lab fit scale-factor`: the
+//! calibrations of calibration/ on a test-rig run, written as the
+//! coefficient files the firmware loads.
+
+use crate::calibration::scale_factor::fit::fit;
+use crate::calibration::scale_factor::multipoint::Plateau;
+use crate::calibration::scale_factor::result::{Segment, SfFit};
+use crate::calibration::thermal::summary::calibrate;
+use crate::cli::args::{Json, Out};
+use crate::cli::output::print_json;
+use crate::cli::run_inputs::{scale_factor_run, thermal_run};
+use crate::error::LabError;
+use clap::Args;
+use gyro_coeffs::file::CoeffFile;
+use std::path::PathBuf;
+
+#[derive(Args, Debug, Clone)]
+pub struct FitThermalArgs {
+    /// Chamber run file (t_s, ref_rate_dps, rate_dps, t_mono_a_c, t_mono_b_c, t_case_c).
+    #[arg(long)]
+    pub data: PathBuf,
+    #[command(flatten)]
+    pub out: Out,
+    #[command(flatten)]
+    pub json: Json,
+}
+
+pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
+    let (_, d) = thermal_run(&a.data)?;
+    let s = calibrate(&d).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    let c = s.coefficients;
+    let mut info = toml::Table::new();
+    info.insert("data".into(), a.data.display().to_string().into());
+    info.insert("rows".into(), (d.t.len() as i64).into());
+    for (k, v) in [
+        ("raw_std_100s_dph", s.raw_std_100s_dph),
+        ("residual_std_100s_dph", s.residual_std_100s_dph),
+        ("cubic_std_100s_dph", s.cubic_std_100s_dph),
+        ("noise_floor_100s_dph", s.noise_floor_100s_dph),
+    ] {
+        info.insert(k.into(), v.into());
+    }
+    info.insert(
+        "record_crc32".into(),
+        format!("0x{:08x}", gyro_coeffs::record::crc_of(&c.to_record())).into(),
+    );
+    let file = CoeffFile::rlg_thermal(c, info);
+    gyro_coeffs::file::write(
+        &a.out.out,
+        &file,
+        "RLG thermal bias model (docs/rlg.md), written by gyro-lab fit thermal.\n\
+         B = bias0 + k1*dT + k2*grad(dT) + k3*dT^2 + k4*T_K + k5*(1 - exp(-t/tau_warm)), deg/h;\n\
+         dT = t_mono_a - t_mono_b. Load with `gyro-lab compensate` or build the firmware with RLG_COEFFS=<this file>.",
+    )
+    .map_err(|e| LabError::coeffs_io(&a.out.out, &e))?;
+    if a.json.json {
+        print_json(&s)?;
+    } else {
+        let v = s.coefficients.values();
+        let e = s.coefficient_se.map(|c| c.values());
+        let names = [
+            "bias0_dph",
+            "k1_dph_per_c",
+            "k2_dph_per_c_per_s",
+            "k3_dph_per_c2",
+            "k4_dph_per_c",
+            "k5_dph",
+            "tau_warm_s",
+        ];
+        for (k, n) in names.iter().enumerate() {
+            match e {
+                Some(e) => println!("  {n:<20} {:>12.6} +- {:.6}", v[k], e[k]),
+                None => println!("  {n:<20} {:>12.6} (standard error not available)", v[k]),
+            }
+        }
+        let se = s.std_100s_se_dph;
+        println!(
+            "std of 100 s means (+- standard error): raw {:.4} +- {:.4} deg/h, classic cubic {:.4} +- {:.4}, \
+             improved model {:.4} +- {:.4}, noise floor {:.4} +- {:.4}",
+            s.raw_std_100s_dph,
+            se[0],
+            s.cubic_std_100s_dph,
+            se[2],
+            s.residual_std_100s_dph,
+            se[1],
+            s.noise_floor_100s_dph,
+            se[3]
+        );
+        println!("written: {}", a.out.out.display());
+    }
+    Ok(())
+}
+
+#[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("Coefficient file to write (what the firmware loads)")))]
+pub struct FitScaleFactorArgs {
+    /// Run file: continuous-rotation or multi-point (t_s, ref_rate_dps, rate_dps, temp_c).
+    #[arg(long)]
+    pub data: PathBuf,
+    #[command(flatten)]
+    pub out: Out,
+    #[command(flatten)]
+    pub json: Json,
+}
+
+/// JSON of `fit scale-factor` (docs/interfaces.md keys first).
+#[derive(serde::Serialize)]
+struct FitJson<'a> {
+    knees_c: Vec<f64>,
+    knees_ci_c: Vec<[f64; 2]>,
+    residual_ppm: f64,
+    residual_ppm_se: f64,
+    segments: &'a [Segment],
+    #[serde(flatten)]
+    fit: &'a SfFit,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    plateaus: Option<&'a [Plateau]>,
+    table: TableJson,
+    out: String,
+}
+
+#[derive(serde::Serialize)]
+struct TableJson {
+    temps_c: Vec<f64>,
+    sf_ppm: Vec<f64>,
+    bias_dph: Vec<f64>,
+    sensor_lag_s: f64,
+    record_crc32: String,
+}
+
+pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
+    let inp = scale_factor_run(&a.data)?;
+    let (f, plateaus) = fit(&inp).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    f.table.check().map_err(|e| {
+        LabError::input(
+            &a.data,
+            format!(
+                "the fitted table is out of the firmware's range ({e:?}): {:?}",
+                f.table
+            ),
+        )
+    })?;
+    let crc = write_table(a, &f)?;
+    let n = f.table.n;
+    if a.json.json {
+        return print_json(&FitJson {
+            knees_c: f.knees.iter().map(|k| k.value).collect(),
+            knees_ci_c: f.knees.iter().map(|k| [k.lo, k.hi]).collect(),
+            residual_ppm: f.residual_ppm.value,
+            residual_ppm_se: f.residual_ppm.se,
+            segments: &f.segments,
+            fit: &f,
+            plateaus: plateaus.as_deref(),
+            table: TableJson {
+                temps_c: f.table.temps_c[..n].to_vec(),
+                sf_ppm: f.table.sf_ppm[..n].to_vec(),
+                bias_dph: f.table.bias_dph[..n].to_vec(),
+                sensor_lag_s: f.table.sensor_lag_s,
+                record_crc32: crc,
+            },
+            out: a.out.out.display().to_string(),
+        });
+    }
+    print_text(&f, &crc, &a.out.out);
+    Ok(())
+}
+
+/// Writes the coefficient file of the fit; its record's CRC.
+fn write_table(a: &FitScaleFactorArgs, f: &SfFit) -> Result<String, LabError> {
+    let record = f.table.to_record();
+    let crc = format!("0x{:08x}", gyro_coeffs::record::crc_of(&record));
+    let mut info = toml::Table::new();
+    info.insert("data".into(), a.data.display().to_string().into());
+    info.insert("method".into(), f.method.name().into());
+    info.insert(
+        "knees_c".into(),
+        toml::Value::Array(f.knees.iter().map(|k| k.value.into()).collect()),
+    );
+    info.insert("residual_ppm".into(), f.residual_ppm.value.into());
+    info.insert("record_crc32".into(), crc.clone().into());
+    gyro_coeffs::file::write(
+        &a.out.out,
+        &CoeffFile::fog_scale_factor(&f.table, info),
+        "FOG scale factor and bias over coil temperature (docs/fog.md), written by gyro-lab fit scale-factor.\n\
+         output = (1 + sf_ppm*1e-6)*rate + bias_dph, linear in the coil temperature between the nodes, held outside;\n\
+         coil temperature = sensor + sensor_lag_s * d(sensor)/dt. Load with `gyro-lab compensate` or build the\n\
+         firmware with FOG_SF_COEFFS=<this file>.",
+    )
+    .map_err(|e| LabError::coeffs_io(&a.out.out, &e))?;
+    Ok(crc)
+}
+
+fn print_text(f: &SfFit, crc: &str, out: &std::path::Path) {
+    println!(
+        "{} fit, {} rows, coil {:.2} .. {:.2} degC",
+        f.method, f.rows_used, f.range_c[0], f.range_c[1]
+    );
+    if f.knees.is_empty() {
+        println!("knees: none (BIC by knee count: {:?})", rounded(&f.bic));
+    }
+    for k in &f.knees {
+        println!(
+            "knee at {:.2} degC (95 % interval {:.2} .. {:.2}); BIC by knee count {:?}",
+            k.value,
+            k.lo,
+            k.hi,
+            rounded(&f.bic)
+        );
+    }
+    for s in &f.segments {
+        println!(
+            "  {:7.2} .. {:7.2} degC: K_SF = 1 {:+.2} ppm ({:.2}) {:+.4} ppm/degC ({:.4}) x T",
+            s.from_c,
+            s.to_c,
+            s.k0_ppm,
+            s.k0_se * 1e6,
+            s.k_t_ppm_per_c,
+            s.k_t_se * 1e6
+        );
+    }
+    if let Some(l) = f.sensor_lag_s {
+        println!(
+            "coil sensor lag {:.1} s (95 % interval {:.1} .. {:.1})",
+            l.value, l.lo, l.hi
+        );
+    }
+    if let Some(b) = f.bias {
+        println!(
+            "bias {:.4} +- {:.4} deg/h at 20 degC, {:+.5} +- {:.5} deg/h/degC",
+            b.at_20c_dph.value, b.at_20c_dph.se, b.slope_dph_per_c.value, b.slope_dph_per_c.se
+        );
+    }
+    for (name, e) in [
+        ("asymmetry", f.asymmetry_ppm),
+        ("nonlinearity", f.nonlinearity_ppm),
+    ] {
+        match e {
+            Some(e) => println!("{name} {:.3} +- {:.3} ppm", e.value, e.se),
+            None => println!("{name}: not measurable on this run"),
+        }
+    }
+    println!(
+        "residual {:.3} +- {:.3} ppm RMS of 60 s means",
+        f.residual_ppm.value, f.residual_ppm.se
+    );
+    for n in &f.notes {
+        println!("note: {n}");
+    }
+    println!("written: {} (record CRC {crc})", out.display());
+}
+
+fn rounded(v: &[f64]) -> Vec<f64> {
+    v.iter().map(|x| (x * 10.0).round() / 10.0).collect()
+}

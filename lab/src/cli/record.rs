@@ -1,0 +1,415 @@
+//! `gyro-lab record`: the board's frames from a serial port (or a raw
+//! capture) into a record directory: `raw.bin` (every byte received),
+//! `fog.csv` and `rlg.csv` (run files, time from the board's closure
+//! counter), `record.json` (the summary). The decoding and the files are
+//! gyro-frames' `Recorder`, the one `cargo xtask qemu` uses too.
+
+use crate::cli::args::{Json, Out};
+use crate::cli::output::print_json;
+use crate::data::run_file::Column;
+use crate::data::table::TextTable;
+use crate::error::LabError;
+use clap::Args;
+use gyro_frames::summary::Summary;
+use gyro_frames::{RateLog, RecordError, Recorder, Reference, Scales};
+use serde::Serialize;
+use std::io::{ErrorKind, Read};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+#[derive(Args, Debug, Clone)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["port", "from"])))]
+#[command(group(clap::ArgGroup::new("reference_source").args(["ref_rate", "reference"])))]
+pub struct RecordArgs {
+    /// Serial port the board's frames arrive on (a USB-serial adapter, or a
+    /// pseudo-terminal).
+    #[arg(long)]
+    pub port: Option<PathBuf>,
+    /// Baud rate of the port.
+    #[arg(long, default_value_t = 2_000_000)]
+    pub baud: u32,
+    /// Decode a raw capture (a `raw.bin`) instead of a port.
+    #[arg(long)]
+    pub from: Option<PathBuf>,
+    #[command(flatten)]
+    pub out: Out,
+    /// Stop after this many seconds (of the host's clock; a capture is read
+    /// to its end). Without it a port is read until Ctrl-C or it goes away.
+    #[arg(long)]
+    pub duration_s: Option<f64>,
+    /// A constant reference rate, deg/s (e.g. the Earth-rate component on
+    /// a static bench).
+    #[arg(long = "ref-rate-dps", allow_negative_numbers = true)]
+    pub ref_rate: Option<f64>,
+    /// A rate-table log (`t_s`, `ref_rate_dps`), merged by time.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// The board's time at the log's zero, s (board time = log time + offset).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub reference_offset_s: f64,
+    /// RLG encoder counts per degree (quadrature edges, x4).
+    #[arg(long, default_value_t = 8_000.0)]
+    pub rlg_counts_per_deg: f64,
+    #[command(flatten)]
+    pub json: Json,
+}
+
+/// How long a read waits for bytes before the loop looks at the clock.
+const READ_TIMEOUT: Duration = Duration::from_millis(100);
+/// How often the progress line is redrawn.
+const PROGRESS_EVERY: Duration = Duration::from_millis(500);
+
+/// `record.json` and the `--json` line.
+#[derive(Serialize)]
+struct RecordJson {
+    source: String,
+    /// Host seconds the record took.
+    elapsed_s: f64,
+    /// Board time of the first and last frame, s.
+    first_s: f64,
+    last_s: f64,
+    frames: u64,
+    bytes: u64,
+    crc_errors: u64,
+    resyncs: u64,
+    skipped_bytes: u64,
+    duplicates: u64,
+    /// Frames lost on the way, with the sequence numbers either side.
+    lost_frames: Vec<LostJson>,
+    lost_frame_count: u64,
+    /// Closures the board reported missed (their angle is lost).
+    closures_missed: u64,
+    /// Each fault flag seen: frames with it, first and last board time.
+    faults: std::collections::BTreeMap<String, FlagJson>,
+    /// Starts of the board the record saw: board time and cause.
+    starts: Vec<(f64, String)>,
+    /// The angle over the record: FOG (deg, eps^2-corrected, nominal scale
+    /// factor) and RLG (counts, deg).
+    fog_angle_deg: f64,
+    rlg_counts: i64,
+    rlg_angle_deg: f64,
+    /// Why the record ended early, if it did.
+    error: Option<String>,
+}
+
+#[derive(Serialize)]
+struct LostJson {
+    after_seq: u16,
+    before_seq: u16,
+    frames: u32,
+    from_s: f64,
+    to_s: f64,
+}
+
+#[derive(Serialize)]
+struct FlagJson {
+    frames: u64,
+    first_s: f64,
+    last_s: f64,
+}
+
+fn summary_json(
+    s: &Summary,
+    source: &str,
+    elapsed: Duration,
+    angles: (f64, i64),
+    counts_per_deg: f64,
+    error: Option<String>,
+) -> RecordJson {
+    RecordJson {
+        source: source.to_string(),
+        elapsed_s: elapsed.as_secs_f64(),
+        first_s: s.first_s,
+        last_s: s.last_s,
+        frames: s.frames,
+        bytes: s.bytes,
+        crc_errors: s.crc_errors,
+        resyncs: s.resyncs,
+        skipped_bytes: s.skipped_bytes,
+        duplicates: s.duplicates,
+        lost_frames: s
+            .lost
+            .iter()
+            .map(|l| LostJson {
+                after_seq: l.after_seq,
+                before_seq: l.before_seq,
+                frames: l.frames,
+                from_s: l.from_s,
+                to_s: l.to_s,
+            })
+            .collect(),
+        lost_frame_count: s.lost_frames,
+        closures_missed: s.closures_missed,
+        faults: s
+            .flags
+            .iter()
+            .map(|f| {
+                (
+                    f.name.clone(),
+                    FlagJson {
+                        frames: f.frames,
+                        first_s: f.first_s,
+                        last_s: f.last_s,
+                    },
+                )
+            })
+            .collect(),
+        starts: s
+            .starts
+            .iter()
+            .map(|(t, c)| (*t, format!("{c:?}")))
+            .collect(),
+        fog_angle_deg: angles.0,
+        rlg_counts: angles.1,
+        rlg_angle_deg: angles.1 as f64 / counts_per_deg,
+        error,
+    }
+}
+
+/// Where the bytes come from.
+enum Source {
+    Port(Box<dyn serialport::SerialPort>),
+    Capture(std::fs::File),
+}
+
+impl Source {
+    /// Reads what is there: `Ok(0)` on a port's timeout, `Ok(None)` at a
+    /// capture's end.
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<Option<usize>> {
+        match self {
+            Source::Port(p) => match p.read(buf) {
+                Ok(0) => Err(std::io::Error::new(
+                    ErrorKind::UnexpectedEof,
+                    "the port closed",
+                )),
+                Ok(n) => Ok(Some(n)),
+                Err(e) if e.kind() == ErrorKind::TimedOut || e.kind() == ErrorKind::Interrupted => {
+                    Ok(Some(0))
+                }
+                Err(e) => Err(e),
+            },
+            Source::Capture(f) => match f.read(buf)? {
+                0 => Ok(None),
+                n => Ok(Some(n)),
+            },
+        }
+    }
+}
+
+fn reference(a: &RecordArgs) -> Result<Reference, LabError> {
+    if let Some(r) = a.ref_rate {
+        if !r.is_finite() {
+            return Err(LabError::Usage(format!("--ref-rate-dps {r}: not finite")));
+        }
+        return Ok(Reference::Constant(r));
+    }
+    let Some(path) = &a.reference else {
+        return Ok(Reference::Constant(0.0));
+    };
+    let t = TextTable::read(path)?;
+    let time = t.time(Column::Time.name(), 2)?;
+    let rate = t.column(Column::RefRate.name())?;
+    RateLog::new(time, rate, a.reference_offset_s)
+        .map(Reference::Log)
+        .map_err(|e| LabError::input(path, format!("{e:?}")))
+}
+
+fn record_error(e: RecordError, source: &Path) -> LabError {
+    match e {
+        RecordError::Io { path, error } => LabError::io(path, error),
+        RecordError::Stream(s) => LabError::input(source, s.to_string()),
+    }
+}
+
+pub fn run(a: &RecordArgs) -> Result<(), LabError> {
+    if !(a.rlg_counts_per_deg.is_finite() && a.rlg_counts_per_deg > 0.0) {
+        return Err(LabError::Usage(format!(
+            "--rlg-counts-per-deg {}: must be positive",
+            a.rlg_counts_per_deg
+        )));
+    }
+    if let Some(d) = a.duration_s {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(LabError::Usage(format!(
+                "--duration-s {d}: must be positive"
+            )));
+        }
+    }
+    let reference = reference(a)?;
+    let (mut source, source_path) = match (&a.port, &a.from) {
+        (Some(p), _) => {
+            let port = serialport::new(p.to_string_lossy(), a.baud)
+                .timeout(READ_TIMEOUT)
+                .open()
+                .map_err(|e| LabError::input(p, format!("cannot open the port: {e}")))?;
+            (Source::Port(port), p.clone())
+        }
+        (None, Some(f)) => {
+            let file = std::fs::File::open(f)
+                .map_err(|e| LabError::input(f, format!("cannot read: {e}")))?;
+            (Source::Capture(file), f.clone())
+        }
+        (None, None) => return Err(LabError::Usage("--port or --from is needed".into())),
+    };
+    let scales = Scales {
+        rlg_counts_per_deg: a.rlg_counts_per_deg,
+        ..Scales::board()
+    };
+    let comment = format!("gyro-lab record from {}", source_path.display());
+    let mut rec = Recorder::create(&a.out.out, scales, reference, &comment)
+        .map_err(|e| record_error(e, &source_path))?;
+    let stop = Arc::new(AtomicBool::new(false));
+    if matches!(source, Source::Port(_)) {
+        let s = stop.clone();
+        // A second handler (a test harness) is not an error: Ctrl-C then
+        // ends the process as usual, after the last flush.
+        let _ = ctrlc::set_handler(move || s.store(true, Ordering::SeqCst));
+    }
+    let start = Instant::now();
+    let mut progress = Progress::new(!a.json.json);
+    let mut buf = vec![0u8; 64 * 1024];
+    let mut ended: Option<LabError> = None;
+    loop {
+        if stop.load(Ordering::SeqCst) {
+            break;
+        }
+        if a.duration_s
+            .is_some_and(|d| start.elapsed().as_secs_f64() >= d)
+        {
+            break;
+        }
+        match source.read(&mut buf) {
+            Ok(None) => break,
+            Ok(Some(n)) => {
+                if let Err(e) = rec.push(&buf[..n]) {
+                    ended = Some(record_error(e, &source_path));
+                    break;
+                }
+            }
+            Err(e) => {
+                ended = Some(LabError::input(
+                    &source_path,
+                    format!("the port went away: {e}"),
+                ));
+                break;
+            }
+        }
+        progress.show(&rec, start.elapsed());
+    }
+    progress.clear();
+    let angles = rec.angles();
+    let summary = rec.finish().map_err(|e| record_error(e, &source_path))?;
+    if ended.is_none() && summary.frames == 0 {
+        ended = Some(LabError::input(
+            &source_path,
+            format!("no frame found in {} bytes", summary.bytes),
+        ));
+    }
+    let json = summary_json(
+        &summary,
+        &source_path.display().to_string(),
+        start.elapsed(),
+        angles,
+        a.rlg_counts_per_deg,
+        ended.as_ref().map(|e| e.to_string()),
+    );
+    let path = a.out.out.join("record.json");
+    let text = serde_json::to_string_pretty(&json).map_err(|e| LabError::io(&path, e))?;
+    std::fs::write(&path, text + "\n").map_err(|e| LabError::io(&path, e))?;
+    if a.json.json {
+        print_json(&json)?;
+    } else {
+        print_summary(&json, &a.out.out);
+    }
+    match ended {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+fn print_summary(j: &RecordJson, dir: &Path) {
+    println!(
+        "{} frames ({} bytes) from {}, board time {:.3} .. {:.3} s; {} CRC errors, {} resyncs, {} frames lost in {} gaps, {} closures missed on the board",
+        j.frames,
+        j.bytes,
+        j.source,
+        j.first_s,
+        j.last_s,
+        j.crc_errors,
+        j.resyncs,
+        j.lost_frame_count,
+        j.lost_frames.len(),
+        j.closures_missed
+    );
+    for l in &j.lost_frames {
+        println!(
+            "  lost {} frames between sequence {} and {} (board time {:.3} .. {:.3} s)",
+            l.frames, l.after_seq, l.before_seq, l.from_s, l.to_s
+        );
+    }
+    for (name, f) in &j.faults {
+        println!(
+            "  {name}: {} frames, {:.3} .. {:.3} s",
+            f.frames, f.first_s, f.last_s
+        );
+    }
+    println!(
+        "angle over the record: FOG {:.6} deg, RLG {} counts ({:.6} deg)",
+        j.fog_angle_deg, j.rlg_counts, j.rlg_angle_deg
+    );
+    println!(
+        "files: {0}/raw.bin {0}/fog.csv {0}/rlg.csv {0}/record.json",
+        dir.display()
+    );
+}
+
+/// The progress line on stderr while a record runs.
+struct Progress {
+    shown: bool,
+    last: Option<Instant>,
+    frames_then: (u64, Duration),
+}
+
+impl Progress {
+    fn new(shown: bool) -> Self {
+        Self {
+            shown,
+            last: None,
+            frames_then: (0, Duration::ZERO),
+        }
+    }
+
+    fn show(&mut self, rec: &Recorder, elapsed: Duration) {
+        if !self.shown || self.last.is_some_and(|t| t.elapsed() < PROGRESS_EVERY) {
+            return;
+        }
+        self.last = Some(Instant::now());
+        let s = rec.summary();
+        let dt = (elapsed - self.frames_then.1).as_secs_f64().max(1e-9);
+        let fps = (s.frames - self.frames_then.0) as f64 / dt;
+        self.frames_then = (s.frames, elapsed);
+        let latest = rec.latest().map_or(String::from("no frame yet"), |l| {
+            format!(
+                "FOG {:+.4} deg/s, RLG {:+.4} deg/s, coil {:.2} monoblocks {:.2}/{:.2} case {:.2} degC",
+                l.fog_rate_dps, l.rlg_rate_dps, l.coil_c, l.mono_c[0], l.mono_c[1], l.case_c
+            )
+        });
+        let flags: Vec<&str> = s.flags.iter().map(|f| f.name.as_str()).collect();
+        eprint!(
+            "\r\x1b[2K{:.1} s  {:.0} frames/s  {latest}  CRC errors {}  gaps {}  flags up [{}]",
+            elapsed.as_secs_f64(),
+            fps,
+            s.crc_errors,
+            s.lost.len(),
+            flags.join(" ")
+        );
+    }
+
+    fn clear(&self) {
+        if self.shown && self.last.is_some() {
+            eprintln!();
+        }
+    }
+}

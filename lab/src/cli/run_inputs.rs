@@ -1,0 +1,44 @@
+//! Run files turned into what each calibration takes, with the checks a
+//! calibration makes of a run placed at the file's columns.
+
+use crate::calibration::scale_factor::fit::{check_run, RunCheck, MIN_ROTATING_ROWS};
+use crate::calibration::scale_factor::input::{prepare, SfInput, MIN_RATE_DPS, MIN_SPAN_C};
+use crate::calibration::thermal::fit::ThermalData;
+use crate::data::run_file::{Column, RunFile, RunText};
+use crate::error::LabError;
+use std::path::Path;
+
+/// A chamber run for the RLG thermal model: at least 200 rows with the two
+/// monoblock sensors and the case sensor.
+pub fn thermal_run(path: &Path) -> Result<(RunText, ThermalData), LabError> {
+    let (text, [a, b, case]) =
+        RunFile::read(path, 200, [Column::MonoA, Column::MonoB, Column::Case])?;
+    let r = &text.run;
+    let d = ThermalData::new(r.t_s.clone(), (a, b), case, &r.rate_dps, &r.ref_rate_dps);
+    Ok((text, d))
+}
+
+/// A run for the scale-factor fit, checked: `t_s`, `ref_rate_dps`,
+/// `rate_dps`, `temp_c`; rotation present; a temperature span the model
+/// can use.
+pub fn scale_factor_run(path: &Path) -> Result<SfInput, LabError> {
+    let (text, [temp]) = RunFile::read(path, 30, [Column::Temp])?;
+    let r = &text.run;
+    check_run(&r.ref_rate_dps, &temp).map_err(|e| match e {
+        RunCheck::NoRotation(rows) => text.column_error(
+            Column::RefRate,
+            format!(
+                "no rotation: {rows} rows with |{}| >= {} deg/s, at least {MIN_ROTATING_ROWS} needed to measure a scale factor",
+                Column::RefRate.name(),
+                MIN_RATE_DPS
+            ),
+        ),
+        RunCheck::Span(span) => text.column_error(
+            Column::Temp,
+            format!(
+                "temperature span {span:.2} degC over the rotating rows; the scale-factor-over-temperature model needs at least {MIN_SPAN_C} degC"
+            ),
+        ),
+    })?;
+    Ok(prepare(&r.t_s, &r.ref_rate_dps, &r.rate_dps, &temp))
+}

@@ -1,0 +1,35 @@
+//! `gyro-lab simulate`: the simulators' records as files, one command per
+//! simulator.
+
+pub mod chamber;
+pub mod fog;
+pub mod lockin;
+pub mod run;
+pub mod scale_factor;
+
+use crate::error::LabError;
+use clap::Subcommand;
+
+#[derive(Subcommand)]
+pub enum SimulateCmd {
+    /// Closed-loop fiber-optic gyro.
+    Fog(fog::FogArgs),
+    /// RLG fringe signal near lock-in (writes a fringe file).
+    Lockin(lockin::LockinSimArgs),
+    /// RLG in a thermal chamber (writes a run file).
+    Chamber(chamber::ChamberArgs),
+    /// FOG scale-factor calibration run over temperature (continuous rotation or multi-point; writes a run file).
+    ScaleFactor(scale_factor::SimulateArgs),
+    /// A gyro model (model.toml) on a test profile with the project's noise: a run with known effects.
+    Run(run::SimulateRunArgs),
+}
+
+pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
+    match cmd {
+        SimulateCmd::Fog(a) => fog::run(a),
+        SimulateCmd::Lockin(a) => lockin::run(a),
+        SimulateCmd::Chamber(a) => chamber::run(a),
+        SimulateCmd::ScaleFactor(a) => scale_factor::run(a),
+        SimulateCmd::Run(a) => run::run(a),
+    }
+}

@@ -1,0 +1,160 @@
+//! `gyro-lab simulate run`: a gyro model on a test profile with the
+//! project's noise (sim/model_run.rs), written as a run file: a run with
+//! known effects.
+
+use crate::cli::args::{Json, Out, Seed};
+use crate::cli::model_file::read_model;
+use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
+use crate::data::run_file::{Column, RunWriter};
+use crate::error::LabError;
+use crate::sim::model_run::{generate, TestProfile, TrialNoise, TrialRun};
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// Test profiles, as the command line names them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TestProfileArg {
+    /// Rate table: 0, +-10, +-50, +-100, +-200 deg/s in a shuffled order,
+    /// 60 s each, while the chamber sweeps -20 -> +60 -> -20 degC (the coil
+    /// 600 s behind the air); 1 s rows, 2 h.
+    Table,
+    /// The same table at one constant rate (+50 deg/s) and constant
+    /// temperature: a scale-factor error and a bias look alike there.
+    ConstantRate,
+    /// RLG at rest in a thermal chamber (gyro_sp's chamber: case and two
+    /// monoblock sensors with their lags and self-heating), the cycle
+    /// -40 -> +50 degC; 1 s rows, 6 h.
+    Chamber,
+    /// RLG rate steps near lock-in: +-0.03 .. +-3 deg/s log-spaced, 20 s
+    /// each; 10 Hz rows, 30 min.
+    Lockin,
+    /// FOG at rest under 20 Hz sinusoidal vibration switched between
+    /// amplitudes (0, 2 000, 5 000, 10 000 deg/s^2 peak), 30 s each, with
+    /// `ref_acc_dps2`; 200 Hz rows, 10 min.
+    Vibration,
+    /// FOG under one constant vibration level: rectification looks like a
+    /// bias.
+    ConstantVibration,
+}
+
+impl From<TestProfileArg> for TestProfile {
+    fn from(p: TestProfileArg) -> Self {
+        match p {
+            TestProfileArg::Table => TestProfile::Table,
+            TestProfileArg::ConstantRate => TestProfile::ConstantRate,
+            TestProfileArg::Chamber => TestProfile::Chamber,
+            TestProfileArg::Lockin => TestProfile::Lockin,
+            TestProfileArg::Vibration => TestProfile::Vibration,
+            TestProfileArg::ConstantVibration => TestProfile::ConstantVibration,
+        }
+    }
+}
+
+/// Writes a run file: the required columns, then those the profile has.
+pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> Result<(), LabError> {
+    let inp = &run.inputs;
+    let mut cols = vec![
+        (Column::Time, Shortest),
+        (Column::RefRate, Fixed(9)),
+        (Column::Rate, Exp(12)),
+    ];
+    if inp.temp.is_some() {
+        cols.push((Column::Temp, Fixed(4)));
+    }
+    if run.mono.is_some() {
+        cols.extend([(Column::MonoA, Fixed(4)), (Column::MonoB, Fixed(4))]);
+    }
+    if run.case.is_some() {
+        cols.push((Column::Case, Fixed(4)));
+    }
+    if run.acc_column {
+        cols.push((Column::RefAcc, Fixed(6)));
+    }
+    let mut w = RunWriter::create(path, comment, &cols)?;
+    let mut row = Vec::with_capacity(cols.len());
+    for k in 0..inp.len() {
+        row.clear();
+        row.extend([inp.t[k], inp.w[k], run.rate[k]]);
+        if let Some(tc) = &inp.temp {
+            row.push(tc[k]);
+        }
+        if let Some((a, b)) = &run.mono {
+            row.extend([a[k], b[k]]);
+        }
+        if let Some(c) = &run.case {
+            row.push(c[k]);
+        }
+        if run.acc_column {
+            row.push(inp.acc[k]);
+        }
+        w.row(&row)?;
+    }
+    w.finish()
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SimulateRunArgs {
+    /// The truth: a model file (its gyro kind must match the profile's).
+    #[arg(long)]
+    pub model: PathBuf,
+    #[arg(long, value_enum)]
+    pub profile: TestProfileArg,
+    /// Row period and duration, s (default: the profile's).
+    #[arg(long)]
+    pub dt_s: Option<f64>,
+    #[arg(long)]
+    pub duration_s: Option<f64>,
+    /// Angle random walk, deg/sqrt(h), and bias instability, deg/h
+    /// (default: a navigation-grade gyro of the profile's kind).
+    #[arg(long)]
+    pub arw_dpsh: Option<f64>,
+    #[arg(long)]
+    pub bias_instability_dph: Option<f64>,
+    #[command(flatten)]
+    pub seed: Seed,
+    #[command(flatten)]
+    pub out: Out,
+    #[command(flatten)]
+    pub json: Json,
+}
+
+pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
+    let profile = TestProfile::from(a.profile);
+    let model = read_model(&a.model, profile.gyro())?;
+    let (dt0, dur0) = profile.default_timing();
+    let dt = a.dt_s.unwrap_or(dt0);
+    let dur = a.duration_s.unwrap_or(dur0);
+    if !(dt.is_finite() && dt > 0.0 && dur.is_finite() && dur >= 10.0 * dt && dur / dt <= 2e7) {
+        return Err(LabError::Usage(format!(
+            "--dt-s {dt} --duration-s {dur}: out of range"
+        )));
+    }
+    let nom = TrialNoise::nominal(profile.gyro());
+    let noise = TrialNoise {
+        arw_dpsh: a.arw_dpsh.unwrap_or(nom.arw_dpsh).max(0.0),
+        bias_instability_dph: a
+            .bias_instability_dph
+            .unwrap_or(nom.bias_instability_dph)
+            .max(0.0),
+    };
+    let run = generate(&model, profile, noise, a.seed.seed, Some((dt, dur)));
+    write(
+        &run,
+        &a.out.out,
+        &format!(
+            "gyro-lab simulate run: profile {:?}, model {}, seed {}, ARW {} deg/sqrt(h), bias instability {} deg/h",
+            a.profile,
+            a.model.display(),
+            a.seed.seed,
+            noise.arw_dpsh,
+            noise.bias_instability_dph
+        ),
+    )?;
+    let j = serde_json::json!({"rows": run.inputs.len(), "out": a.out.out});
+    if a.json.json {
+        println!("{j}");
+    } else {
+        println!("{} rows -> {}", run.inputs.len(), a.out.out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,11 @@
+//! The lab's data files (docs/interfaces.md "Data files"): CSV with one
+//! header row and `#` comment lines before it. Each file kind names its
+//! columns once, in its own module; reading checks every cell it uses and
+//! places every error at its file, line and column.
+
+pub mod allan_file;
+pub mod csv_writer;
+pub mod fringe_file;
+pub mod residual_file;
+pub mod run_file;
+pub mod table;

@@ -1,0 +1,121 @@
+//! How far a residual stands above its own noise: the gap (the RMS of its
+//! window means), the noise floor there, and the stretches where it stands
+//! out.
+
+use super::windows::Windows;
+use crate::noise::analysis::{analyse, sample_period, Allan};
+use crate::noise::terms;
+
+/// A stretch where the model and the data disagree.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Disagreement {
+    pub from_s: f64,
+    pub to_s: f64,
+    /// Largest smoothed residual there, deg/h.
+    pub peak_dph: f64,
+}
+
+/// RMS of the window means of `r` (deg/s) in deg/h.
+pub fn gap(win: &Windows, r: &[f64]) -> f64 {
+    let m = win.mean(r);
+    (m.iter().map(|v| v * v).sum::<f64>() / m.len().max(1) as f64).sqrt() * 3600.0
+}
+
+/// The Allan analysis of a residual when its sampling allows.
+pub fn allan_of(t: &[f64], r: &[f64]) -> Option<Allan> {
+    if t.len() < 10 {
+        return None;
+    }
+    let tau0 = sample_period(t).ok()?;
+    analyse(r, tau0).ok()
+}
+
+/// The noise of a mean over `tau` from a residual's Allan model
+/// (quantization 2Q^2/tau^2, the variance of a mean of white angle noise;
+/// angle random walk N^2/tau; bias instability its floor), deg/h; a robust
+/// scatter of first differences when the Allan analysis is not possible.
+fn noise_at(a: Option<&Allan>, t: &[f64], r: &[f64], tau: f64) -> f64 {
+    if let Some(a) = a {
+        let c = &a.terms.c;
+        let v = 2.0 * c[0] / (tau * tau) + c[1] / tau + c[2] * terms::basis(2, tau);
+        if v > 0.0 {
+            return v.sqrt() * 3600.0;
+        }
+    }
+    let mut d: Vec<f64> = r.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+    d.sort_by(f64::total_cmp);
+    let sigma = d.get(d.len() / 2).copied().unwrap_or(0.0) * 1.4826 / 2f64.sqrt();
+    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64;
+    sigma * (dt / tau).min(1.0).sqrt() * 3600.0
+}
+
+/// The noise floor of the gap over windows `win` of `window_s`: the
+/// measured Allan deviation at the window (a periodic error, the FOG's
+/// under vibration, averages out of a window mean and out of it; it reads
+/// white angle noise sqrt(3/2) high), robustly (the median of the squared
+/// differences of consecutive window means, so slow effects and a few
+/// steps are differenced away), or the Allan model's noise of a window
+/// mean where that is lower, deg/h.
+pub fn noise_floor(
+    win: &Windows,
+    allan: Option<&Allan>,
+    t: &[f64],
+    r: &[f64],
+    window_s: f64,
+) -> f64 {
+    let model_floor = noise_at(allan, t, r, window_s);
+    let means = win.mean(r);
+    let mut d2: Vec<f64> = means.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
+    d2.sort_by(f64::total_cmp);
+    // Median of chi-square with one degree of freedom: 0.4549.
+    let measured = d2
+        .get(d2.len() / 2)
+        .map_or(f64::INFINITY, |m| (m / (2.0 * 0.454_936)).sqrt() * 3600.0);
+    if d2.len() >= 10 {
+        measured.min(model_floor)
+    } else {
+        model_floor
+    }
+}
+
+/// The stretches where the residual smoothed over `smooth_s` stands more
+/// than three floors out; the floor there is the Allan noise terms
+/// (quantization, angle random walk, bias instability: a missing effect's
+/// drift shows as the others) at `smooth_s`.
+pub fn disagreements(
+    t: &[f64],
+    r: &[f64],
+    allan: Option<&Allan>,
+    smooth_s: f64,
+) -> Vec<Disagreement> {
+    let smooth = Windows::new(t, smooth_s);
+    let sm = smooth.mean(r);
+    let floor_s = noise_at(allan, t, r, smooth_s);
+    let mut disagreements: Vec<Disagreement> = vec![];
+    let half = 0.5 * smooth_s;
+    // A window's span, clipped to the record (a record shorter than a window
+    // is one window).
+    let (t_first, t_last) = (t[0], t[t.len() - 1]);
+    let span = |t: f64| ((t - half).max(t_first), (t + half).min(t_last));
+    for (i, v) in sm.iter().enumerate() {
+        let dph = v * 3600.0;
+        if dph.abs() > 3.0 * floor_s {
+            let t = smooth.t[i];
+            // Stretches a smoothing window or two apart are one.
+            match disagreements.last_mut() {
+                Some(d) if span(t).0 <= d.to_s + 2.0 * smooth_s => {
+                    d.to_s = span(t).1;
+                    if dph.abs() > d.peak_dph.abs() {
+                        d.peak_dph = dph;
+                    }
+                }
+                _ => disagreements.push(Disagreement {
+                    from_s: span(t).0,
+                    to_s: span(t).1,
+                    peak_dph: dph,
+                }),
+            }
+        }
+    }
+    disagreements
+}

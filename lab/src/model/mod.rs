@@ -1,0 +1,11 @@
+//! The behavioural gyro model: the named effects of docs/interfaces.md
+//! (effects.rs, on the run's inputs of inputs.rs), a model as a gyro kind
+//! with its effects (gyro_model.rs) and its file (file.rs), and the
+//! discovery of what a model misses (discovery/).
+
+pub mod discovery;
+pub mod effects;
+pub mod file;
+pub mod gyro_kind;
+pub mod gyro_model;
+pub mod inputs;

@@ -1,0 +1,156 @@
+//! The Allan analysis of one rate record (IEEE 952, docs/noise.md):
+//! overlapping Allan deviation at log-spaced averaging times (adev.rs) with
+//! chi-square intervals from Greenhall's degrees of freedom (edf.rs), and
+//! the noise terms fitted to the whole curve (terms.rs).
+
+use super::terms::{self, TermFit};
+use super::{adev, edf};
+
+/// Averaging times per decade.
+pub const PER_DECADE: usize = 10;
+/// Largest deviation of a sample interval from the median interval, relative.
+pub const SAMPLING_TOLERANCE: f64 = 0.01;
+
+/// The analysis of one record.
+pub struct Allan {
+    pub tau0: f64,
+    pub n: usize,
+    pub ms: Vec<usize>,
+    pub taus: Vec<f64>,
+    /// Overlapping Allan variance, (deg/s)^2, and its 95 % interval.
+    pub avar: Vec<f64>,
+    pub avar_lo: Vec<f64>,
+    pub avar_hi: Vec<f64>,
+    pub terms: TermFit,
+    /// Mean rate, deg/s, and its standard error: the fitted model's Allan
+    /// deviation at the record's length (for white noise exactly the
+    /// standard error of the mean; it holds for correlated noise too).
+    pub mean_dps: f64,
+    pub mean_se_dps: f64,
+}
+
+/// Why a record cannot be analysed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum AllanError {
+    /// Fewer than 3 samples (this many).
+    TooShort(usize),
+    /// Every sample the same.
+    Constant,
+}
+
+impl std::fmt::Display for AllanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AllanError::TooShort(n) => write!(
+                f,
+                "{n} samples: too short for even one averaging time (3 needed for tau = tau0)"
+            ),
+            AllanError::Constant => f.write_str(
+                "the record is constant: its Allan deviation is zero, there is no noise to analyse",
+            ),
+        }
+    }
+}
+
+/// Analyses `y` sampled every `tau0` s (the units of `y` carry through:
+/// deg/s for the reported terms; the mean's standard error in `y`'s unit).
+pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
+    let n = y.len();
+    if n < 3 {
+        return Err(AllanError::TooShort(n));
+    }
+    let first = y[0];
+    if y.iter().all(|&v| v == first) {
+        return Err(AllanError::Constant);
+    }
+    let ms = adev::averaging_factors(n, PER_DECADE);
+    let taus: Vec<f64> = ms.iter().map(|&m| m as f64 * tau0).collect();
+    let avar = adev::oavar(y, &ms);
+    let terms = terms::fit(&taus, &avar, &ms, n + 1);
+    let (mut lo, mut hi) = (vec![], vec![]);
+    for (i, &a) in avar.iter().enumerate() {
+        let (l, h) = edf::interval(a.sqrt(), terms.edf[i], terms::CONF);
+        lo.push(l * l);
+        hi.push(h * h);
+    }
+    let mean = y.iter().sum::<f64>() / n as f64;
+    let mean_se = terms.model_at(n as f64 * tau0).sqrt();
+    Ok(Allan {
+        tau0,
+        n,
+        ms,
+        taus,
+        avar,
+        avar_lo: lo,
+        avar_hi: hi,
+        terms,
+        mean_dps: mean,
+        mean_se_dps: mean_se,
+    })
+}
+
+/// Why a record's sampling does not suit the Allan variance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SamplingError {
+    /// The median interval is not positive: time does not increase.
+    NotIncreasing,
+    /// Interval `row - 1 .. row` strays from the median.
+    Uneven {
+        row: usize,
+        interval: f64,
+        median: f64,
+    },
+}
+
+impl SamplingError {
+    /// The row the error is at.
+    pub fn row(&self) -> usize {
+        match self {
+            SamplingError::NotIncreasing => 1,
+            SamplingError::Uneven { row, .. } => *row,
+        }
+    }
+}
+
+impl std::fmt::Display for SamplingError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SamplingError::NotIncreasing => f.write_str("time does not increase"),
+            SamplingError::Uneven {
+                interval, median, ..
+            } => write!(
+                f,
+                "sampling not uniform: interval {} s where the median is {} s (tolerance {} %); \
+                 the Allan variance needs uniform samples",
+                interval,
+                median,
+                SAMPLING_TOLERANCE * 100.0
+            ),
+        }
+    }
+}
+
+/// The sample period of `t` (the median interval), checked: every interval
+/// within [`SAMPLING_TOLERANCE`] of it.
+pub fn sample_period(t: &[f64]) -> Result<f64, SamplingError> {
+    if t.len() < 2 {
+        return Ok(1.0);
+    }
+    let d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let mut sorted = d.clone();
+    sorted.sort_by(f64::total_cmp);
+    let med = sorted[sorted.len() / 2];
+    if med.is_nan() || med <= 0.0 {
+        return Err(SamplingError::NotIncreasing);
+    }
+    for (k, h) in d.iter().enumerate() {
+        if (*h - med).abs() > SAMPLING_TOLERANCE * med {
+            return Err(SamplingError::Uneven {
+                row: k + 1,
+                interval: *h,
+                median: med,
+            });
+        }
+    }
+    Ok(med)
+}

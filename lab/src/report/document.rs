@@ -1,0 +1,79 @@
+//! A report under construction: headings, paragraphs, tables and plots,
+//! made into one self-contained HTML page.
+
+use super::plot::{self, Axes, Series};
+use super::text::esc;
+use std::fmt::Write as _;
+
+const CSS: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}\
+h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}\
+table{border-collapse:collapse;margin:0.8em 0}td,th{border:1px solid #bbb;padding:3px 8px;\
+text-align:right}th{background:#eee}td:first-child,th:first-child{text-align:left}\
+figure{margin:1em 0}figcaption{font-size:0.9em;color:#555}p.note{color:#555;font-size:0.9em}";
+
+/// A report under construction.
+pub struct Report {
+    title: String,
+    body: String,
+    figures: usize,
+}
+
+impl Report {
+    pub fn new(title: &str) -> Self {
+        Self {
+            title: title.to_owned(),
+            body: String::new(),
+            figures: 0,
+        }
+    }
+
+    pub fn heading(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<h2>{}</h2>", esc(text));
+    }
+
+    pub fn paragraph(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<p>{}</p>", esc(text));
+    }
+
+    pub fn note(&mut self, text: &str) {
+        let _ = writeln!(self.body, "<p class=\"note\">{}</p>", esc(text));
+    }
+
+    pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) {
+        self.body.push_str("<table>\n<tr>");
+        for h in header {
+            let _ = write!(self.body, "<th>{}</th>", esc(h));
+        }
+        self.body.push_str("</tr>\n");
+        for r in rows {
+            self.body.push_str("<tr>");
+            for c in r {
+                let _ = write!(self.body, "<td>{}</td>", esc(c));
+            }
+            self.body.push_str("</tr>\n");
+        }
+        self.body.push_str("</table>\n");
+    }
+
+    /// A plot, drawn now as inline SVG.
+    pub fn plot(&mut self, axes: &Axes, series: &[Series], caption: &str) {
+        self.figures += 1;
+        let svg = plot::svg(axes, series);
+        let _ = write!(
+            self.body,
+            "<figure id=\"fig{}\">\n{svg}\n<figcaption>Figure {}. {}</figcaption>\n</figure>\n",
+            self.figures,
+            self.figures,
+            esc(caption)
+        );
+    }
+
+    pub fn html(&self) -> String {
+        format!(
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{t}</title>\n\
+             <style>{CSS}</style>\n</head>\n<body>\n<h1>{t}</h1>\n{}</body>\n</html>\n",
+            self.body,
+            t = esc(&self.title)
+        )
+    }
+}

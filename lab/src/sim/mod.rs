@@ -1,0 +1,14 @@
+//! The lab's simulators, each producing the records a test rig would: the
+//! FOG core closed around the simulated optics (fog_run.rs), an RLG in a
+//! thermal chamber (chamber.rs), the FOG scale-factor rig (scale_factor_rig.rs),
+//! RLG fringes near lock-in (fringe.rs), a gyro model with the project's
+//! noise (model_run.rs), records of known noise terms (noise_run.rs) and
+//! the byte stream a board sends (board_stream.rs).
+
+pub mod board_stream;
+pub mod chamber;
+pub mod fog_run;
+pub mod fringe;
+pub mod model_run;
+pub mod noise_run;
+pub mod scale_factor_rig;

@@ -1,0 +1,453 @@
+//! `gyro-lab record` as it will be used: the firmware under QEMU with its
+//! USART on a pseudo-terminal, read by the recorder as a USB-serial adapter
+//! would be; then the same through a relay that damages the stream, with
+//! the damage known; then the lab's analyses on what was recorded.
+//!
+//! QEMU starts halted (-S) and is told to run (`cont` on its monitor) only
+//! once the reader holds the terminal: QEMU's pty backend drops output
+//! while nobody has the other side open.
+
+use crate::{qemu_command, root, wait_progressing, QEMU_STALL};
+use anyhow::{bail, Context, Result};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Frame length on the wire (docs/frame.md).
+const FRAME: usize = 86;
+
+/// A QEMU run halted at start with its serial port on a new pty.
+struct PtyQemu {
+    child: Child,
+    pts: PathBuf,
+    monitor: PathBuf,
+    log: PathBuf,
+}
+
+fn start_qemu_on_pty(elf: &Path, dir: &Path) -> Result<PtyQemu> {
+    std::fs::create_dir_all(dir)?;
+    let monitor = dir.join("monitor.sock");
+    let _ = std::fs::remove_file(&monitor);
+    let log = dir.join("defmt.bin");
+    let mut cmd = qemu_command(elf, "pty");
+    // Halted until `cont`, with a monitor socket to say it on.
+    let args: Vec<String> = cmd
+        .get_args()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    let mut c = Command::new(cmd.get_program());
+    let mut it = args.iter().peekable();
+    while let Some(a) = it.next() {
+        if a == "-monitor" {
+            it.next();
+            c.arg("-monitor")
+                .arg(format!("unix:{},server=on,wait=off", monitor.display()));
+        } else {
+            c.arg(a);
+        }
+    }
+    c.arg("-S");
+    cmd = c;
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting qemu-system-arm")?;
+    // "char device redirected to /dev/pts/N (label serial0)": QEMU says it
+    // on stdout or stderr before the halted guest writes anything. Stdout
+    // then carries the guest's defmt log (to `log`); stderr is drained.
+    let (tx, rx) = std::sync::mpsc::channel::<PathBuf>();
+    let stdout = child.stdout.take().context("QEMU's stdout")?;
+    let stderr = child.stderr.take().context("QEMU's stderr")?;
+    let mut log_file = std::fs::File::create(&log)?;
+    let tx2 = tx.clone();
+    std::thread::spawn(move || {
+        let mut r = BufReader::new(stdout);
+        let mut line = String::new();
+        while r.read_line(&mut line).unwrap_or(0) > 0 {
+            if let Some(p) = pts_of(&line) {
+                let _ = tx.send(p);
+                break;
+            }
+            line.clear();
+        }
+        let _ = std::io::copy(&mut r, &mut log_file);
+    });
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            if let Some(p) = pts_of(&line) {
+                let _ = tx2.send(p);
+            }
+        }
+    });
+    let pts = match rx.recv_timeout(Duration::from_secs(30)) {
+        Ok(p) => p,
+        Err(_) => {
+            let _ = child.kill();
+            bail!("QEMU did not name its pty within 30 s");
+        }
+    };
+    Ok(PtyQemu {
+        child,
+        pts,
+        monitor,
+        log,
+    })
+}
+
+/// The pty in QEMU's "char device redirected to /dev/pts/N" line.
+fn pts_of(line: &str) -> Option<PathBuf> {
+    let rest = line.split("redirected to ").nth(1)?;
+    Some(PathBuf::from(rest.split_whitespace().next()?))
+}
+
+/// Tells the halted QEMU to run, once the reader has had time to open the
+/// pty (QEMU looks for a reader every second).
+fn cont(monitor: &Path) -> Result<()> {
+    std::thread::sleep(Duration::from_millis(2_500));
+    let mut s = std::os::unix::net::UnixStream::connect(monitor)
+        .with_context(|| format!("QEMU monitor {}", monitor.display()))?;
+    s.write_all(b"cont\n")?;
+    // Keep the connection until QEMU has read it.
+    std::thread::sleep(Duration::from_millis(200));
+    Ok(())
+}
+
+/// Runs `gyro-lab record --port <pts>` into `out`; returns the child.
+fn start_recorder(lab: &Path, pts: &Path, out: &Path, reference: &Path) -> Result<Child> {
+    let _ = std::fs::remove_dir_all(out);
+    Command::new(lab)
+        .args(["record", "--json", "--port"])
+        .arg(pts)
+        .arg("--out")
+        .arg(out)
+        .arg("--reference")
+        .arg(reference)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting gyro-lab record")
+}
+
+/// Waits for the recorder (it ends when the port goes away) and returns
+/// its exit status, its JSON line and stderr.
+fn finish_recorder(mut child: Child) -> Result<(i32, serde_json::Value, String)> {
+    let start = Instant::now();
+    loop {
+        if child.try_wait()?.is_some() {
+            break;
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            bail!("gyro-lab record did not end 30 s after QEMU did");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let out = child.wait_with_output()?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let json = serde_json::from_str(stdout.lines().last().unwrap_or("{}"))
+        .context("gyro-lab record's JSON line")?;
+    Ok((
+        out.status.code().unwrap_or(-1),
+        json,
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
+/// The data rows of a run file (its `#` comment line differs by source).
+fn rows(path: &Path) -> Result<Vec<String>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    Ok(text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(String::from)
+        .collect())
+}
+
+/// A pty pair in raw mode: (master, slave path).
+fn open_pty() -> Result<(OwnedFd, PathBuf)> {
+    let (mut master, mut slave) = (0, 0);
+    let mut name = [0 as libc::c_char; 128];
+    // SAFETY: openpty writes two fds and the slave's name into the buffers.
+    let r = unsafe {
+        libc::openpty(
+            &mut master,
+            &mut slave,
+            name.as_mut_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+        )
+    };
+    if r != 0 {
+        bail!("openpty: {}", std::io::Error::last_os_error());
+    }
+    // Not inherited by the processes started later (the recorder): a
+    // master fd left open in the recorder would hide the hang-up it must see.
+    for fd in [master, slave] {
+        // SAFETY: fcntl on fds just opened.
+        unsafe { libc::fcntl(fd, libc::F_SETFD, libc::FD_CLOEXEC) };
+    }
+    // SAFETY: fresh fds from openpty, owned here.
+    let (master, slave) = unsafe { (OwnedFd::from_raw_fd(master), OwnedFd::from_raw_fd(slave)) };
+    raw_mode(slave.as_raw_fd())?;
+    // SAFETY: openpty wrote a NUL-terminated name.
+    let path = unsafe { std::ffi::CStr::from_ptr(name.as_ptr()) }
+        .to_string_lossy()
+        .into_owned();
+    // The slave stays open until the relay ends, so the master never sees
+    // a hang-up while the recorder reopens it.
+    std::mem::forget(slave);
+    Ok((master, PathBuf::from(path)))
+}
+
+fn raw_mode(fd: i32) -> Result<()> {
+    // SAFETY: termios calls on an open terminal fd.
+    unsafe {
+        let mut t: libc::termios = std::mem::zeroed();
+        if libc::tcgetattr(fd, &mut t) != 0 {
+            bail!("tcgetattr: {}", std::io::Error::last_os_error());
+        }
+        libc::cfmakeraw(&mut t);
+        if libc::tcsetattr(fd, libc::TCSANOW, &t) != 0 {
+            bail!("tcsetattr: {}", std::io::Error::last_os_error());
+        }
+    }
+    Ok(())
+}
+
+/// What the relay did to the stream: the frames it destroyed.
+#[derive(Default)]
+struct Damage {
+    frames_destroyed: Vec<usize>,
+    bit_flips: usize,
+    dropped_bytes: usize,
+    inserted_bytes: usize,
+    dropped_frames: usize,
+    stall_s: f64,
+}
+
+/// The relay's plan, by frame index of the clean stream.
+fn damage_frame(k: usize, frame: &mut Vec<u8>, out: &mut Vec<u8>, d: &mut Damage) -> bool {
+    match k {
+        // Flipped bits: the frame fails its CRC.
+        150 | 640 => {
+            frame[30] ^= 0x04;
+            d.bit_flips += 1;
+            d.frames_destroyed.push(k);
+        }
+        // A dropped byte.
+        300 => {
+            frame.remove(40);
+            d.dropped_bytes += 1;
+            d.frames_destroyed.push(k);
+        }
+        // Inserted bytes between frames, with sync patterns among them.
+        450 => {
+            let junk = [0xA5, 0x5A, 0x04, 0x52, 0x00, 0xA5, 0x5A, 0x13, 0x37];
+            out.extend_from_slice(&junk);
+            d.inserted_bytes += junk.len();
+        }
+        // Three whole frames gone.
+        800..=802 => {
+            d.dropped_frames += 1;
+            d.frames_destroyed.push(k);
+            return false;
+        }
+        // A burst of garbage (a noisy cable) inside a frame.
+        1000 => {
+            let mut x = 0x2545_F491u32;
+            let burst: Vec<u8> = (0..300)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 17;
+                    x ^= x << 5;
+                    x as u8
+                })
+                .collect();
+            frame.splice(20..20, burst.iter().copied());
+            d.inserted_bytes += burst.len();
+            d.frames_destroyed.push(k);
+        }
+        _ => {}
+    }
+    true
+}
+
+/// Copies QEMU's pty to `master`, damaging it by plan, with a stall of a
+/// few seconds in the middle. Ends when QEMU's side closes.
+fn relay(qemu_pts: PathBuf, master: OwnedFd) -> Result<Damage> {
+    let input = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(&qemu_pts)
+        .with_context(|| format!("{}", qemu_pts.display()))?;
+    raw_mode(input.as_raw_fd())?;
+    let mut input = input;
+    let mut output = std::fs::File::from(master);
+    let mut d = Damage::default();
+    let (mut pending, mut k) = (Vec::new(), 0usize);
+    let mut buf = [0u8; 4096];
+    loop {
+        let n = match input.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            // EIO: QEMU closed its side.
+            Err(_) => break,
+        };
+        pending.extend_from_slice(&buf[..n]);
+        let mut out = Vec::new();
+        while pending.len() >= FRAME {
+            let mut frame: Vec<u8> = pending.drain(..FRAME).collect();
+            if damage_frame(k, &mut frame, &mut out, &mut d) {
+                out.extend_from_slice(&frame);
+            }
+            if k == 600 {
+                // A stall: the cable hangs for three seconds.
+                output.write_all(&out)?;
+                out.clear();
+                std::thread::sleep(Duration::from_secs(3));
+                d.stall_s = 3.0;
+            }
+            k += 1;
+        }
+        output.write_all(&out)?;
+    }
+    output.write_all(&pending)?;
+    Ok(d)
+}
+
+/// The pty test and the fault-injection test: (name, passed, detail).
+pub fn run(
+    elf: &Path,
+    clean: &Path,
+    reference: &Path,
+) -> Result<Vec<(&'static str, bool, String)>> {
+    let lab = root().join("target/release/gyro-lab");
+    let mut checks = vec![];
+
+    // 1. QEMU's USART on a pty, read by `gyro-lab record --port`.
+    let dir = root().join("runs/pty");
+    let q = start_qemu_on_pty(elf, &dir)?;
+    let out = dir.join("record");
+    let rec = start_recorder(&lab, &q.pts, &out, reference)?;
+    cont(&q.monitor)?;
+    let mut child = q.child;
+    wait_progressing(&mut child, &[&out.join("raw.bin"), &q.log], QEMU_STALL)?;
+    let (code, json, stderr) = finish_recorder(rec)?;
+    if !out.join("fog.csv").exists() {
+        bail!("gyro-lab record wrote nothing (exit {code}): {stderr}");
+    }
+    let same = rows(&out.join("fog.csv"))? == rows(&clean.join("fog.csv"))?
+        && rows(&out.join("rlg.csv"))? == rows(&clean.join("rlg.csv"))?;
+    let went_away = code == 2 && stderr.contains("the port went away");
+    checks.push((
+        "record_from_pty_equals_the_file_path",
+        same && went_away && json["frames"] == 1200,
+        format!(
+            "{} frames, run files {}, exit {code} ({})",
+            json["frames"],
+            if same { "identical" } else { "DIFFERENT" },
+            stderr.lines().last().unwrap_or("").trim()
+        ),
+    ));
+
+    // 2. The same through a relay that damages the stream.
+    let dir = root().join("runs/relay");
+    let q = start_qemu_on_pty(elf, &dir)?;
+    let (master, relay_pts) = open_pty()?;
+    let out = dir.join("record");
+    let rec = start_recorder(&lab, &relay_pts, &out, reference)?;
+    let qemu_pts = q.pts.clone();
+    let relay = std::thread::spawn(move || relay(qemu_pts, master));
+    cont(&q.monitor)?;
+    let mut child = q.child;
+    wait_progressing(&mut child, &[&out.join("raw.bin"), &q.log], QEMU_STALL)?;
+    let damage = relay
+        .join()
+        .map_err(|_| anyhow::anyhow!("the relay panicked"))??;
+    let (code, json, stderr) = finish_recorder(rec)?;
+    if !out.join("fog.csv").exists() {
+        bail!("gyro-lab record wrote nothing (exit {code}): {stderr}");
+    }
+    let clean_json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(clean.join("angles.json"))?)?;
+    let lost = json["lost_frame_count"].as_u64().unwrap_or(u64::MAX);
+    let truth = damage.frames_destroyed.len() as u64;
+    let angle_same = json["fog_angle_deg"] == clean_json["fog_angle_deg"]
+        && json["rlg_counts"] == clean_json["rlg_counts"];
+    let kept = json["frames"].as_u64() == Some(1200 - truth);
+    checks.push((
+        "record_through_a_damaging_relay",
+        lost == truth && angle_same && kept && code == 2 && !stderr.contains("panicked"),
+        format!(
+            "{} bit flips, {} dropped bytes, {} inserted bytes, {} dropped frames, {:.0} s stall: \
+             {truth} frames destroyed, {lost} reported lost; {} frames kept, {} CRC errors, {} resyncs; \
+             angle {} (FOG {} deg, RLG {} counts)",
+            damage.bit_flips,
+            damage.dropped_bytes,
+            damage.inserted_bytes,
+            damage.dropped_frames,
+            damage.stall_s,
+            json["frames"],
+            json["crc_errors"],
+            json["resyncs"],
+            if angle_same { "continuous" } else { "BROKEN" },
+            json["fog_angle_deg"],
+            json["rlg_counts"]
+        ),
+    ));
+
+    // 3. The lab's analyses on the damaged record: board to lab, end to end.
+    let fog = out.join("fog.csv");
+    let allan = Command::new(&lab)
+        .args(["allan", "--json", "--data"])
+        .arg(&fog)
+        .arg("--out")
+        .arg(dir.join("allan"))
+        .output()?;
+    let a: serde_json::Value = serde_json::from_str(
+        String::from_utf8_lossy(&allan.stdout)
+            .lines()
+            .last()
+            .unwrap_or("{}"),
+    )
+    .unwrap_or_default();
+    checks.push((
+        "allan_on_the_recorded_file",
+        allan.status.success() && a["taus_s"].as_array().is_some_and(|t| !t.is_empty()),
+        format!(
+            "exit {}, {} averaging times",
+            allan.status,
+            a["taus_s"].as_array().map_or(0, |t| t.len())
+        ),
+    ));
+    let disc = Command::new(&lab)
+        .args(["discover", "--gyro", "fog", "--json", "--data"])
+        .arg(&fog)
+        .arg("--out")
+        .arg(dir.join("discover"))
+        .output()?;
+    let v: serde_json::Value = serde_json::from_str(
+        String::from_utf8_lossy(&disc.stdout)
+            .lines()
+            .last()
+            .unwrap_or("{}"),
+    )
+    .unwrap_or_default();
+    let (before, after) = (
+        v["gap_before_dph"].as_f64().unwrap_or(f64::NAN),
+        v["gap_after_dph"].as_f64().unwrap_or(f64::NAN),
+    );
+    checks.push((
+        "discover_on_the_recorded_file",
+        disc.status.success() && after <= before,
+        format!(
+            "exit {}, gap {before:.3} -> {after:.3} deg/h, found {}",
+            disc.status, v["found"]
+        ),
+    ));
+    Ok(checks)
+}
