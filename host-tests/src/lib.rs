@@ -1,10 +1,9 @@
 //! Helpers shared by the host tests: the firmware core closed around the
 //! simulated gyro, with the truth alongside.
 
-use gyro_sim::{FogRig, OpticsParams, Profile};
 pub use gyro_sim::vibration_drift::{vibration, vibration_drift, Drift, DEG, DPH};
+use gyro_sim::{FogRig, OpticsParams, Profile};
 use gyro_sp::fog::{ClosureOutput, Faults, FogConfig, FogParams};
-
 
 /// A rig with the reference instrument, detector matched to phi0.
 pub fn rig(

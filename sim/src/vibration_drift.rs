@@ -272,7 +272,10 @@ pub fn eps2_point(
     mut progress: impl FnMut(&Eps2Point),
 ) -> Result<Eps2Point, ConfigError> {
     let mut rig = eps2_rig(params, vibration(eps_dps2, freq_hz))?;
-    let formula_dph = rig.cfg.predicted_vibration_drift((eps_dps2 * DEG).powi(2) / 2.0) * DPH;
+    let formula_dph = rig
+        .cfg
+        .predicted_vibration_drift((eps_dps2 * DEG).powi(2) / 2.0)
+        * DPH;
     let drift = vibration_drift(&mut rig, freq_hz, EPS2_SETTLE_CLOSURES, |d| {
         let p = Eps2Point {
             formula_dph,

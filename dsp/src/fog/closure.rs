@@ -357,7 +357,10 @@ mod tests {
             if want < (1 << 31) - (1 << 16) {
                 assert_eq!(got, want, "{a} * {g}");
             } else {
-                assert!(got == i32::MAX as i64 && want - got <= 1 << 16, "{a} * {g}: {got} vs {want}");
+                assert!(
+                    got == i32::MAX as i64 && want - got <= 1 << 16,
+                    "{a} * {g}: {got} vs {want}"
+                );
             }
         }
         assert_eq!(round_residual(1, 1 << 15), 1);

@@ -254,7 +254,9 @@ impl FogConfig {
         // vibration (by 1/(1 - excess share), docs/fog.md).
         let settle: f64 = if p.detector_tau_s > 0.0 {
             (p.skip_samples..p.samples_per_half)
-                .map(|i| (-(i as f64) * p.tau_s / p.samples_per_half as f64 / p.detector_tau_s).exp())
+                .map(|i| {
+                    (-(i as f64) * p.tau_s / p.samples_per_half as f64 / p.detector_tau_s).exp()
+                })
                 .sum()
         } else {
             0.0

@@ -191,8 +191,16 @@ mod tests {
             c += r.cos() * p;
             rs += r * r.sin() * p;
         }
-        assert!((cfg.mean_cos() - c).abs() < 1e-9, "{} vs {c}", cfg.mean_cos());
-        assert!((cfg.mean_r_sin() - rs).abs() < 1e-9, "{} vs {rs}", cfg.mean_r_sin());
+        assert!(
+            (cfg.mean_cos() - c).abs() < 1e-9,
+            "{} vs {c}",
+            cfg.mean_cos()
+        );
+        assert!(
+            (cfg.mean_r_sin() - rs).abs() < 1e-9,
+            "{} vs {rs}",
+            cfg.mean_r_sin()
+        );
     }
 
     #[test]

@@ -22,8 +22,8 @@ pub mod faults;
 pub mod gain_loop;
 pub mod layout;
 pub mod lock;
-pub mod residual;
 mod modulator;
+pub mod residual;
 pub mod scale_factor;
 pub mod vibration;
 

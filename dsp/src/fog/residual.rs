@@ -96,7 +96,11 @@ mod tests {
         ] {
             let s = Sine::new(r);
             let want = (r as f64 * RAD_PER_PHASE_LSB).powi(2) * 2f64.powi(32);
-            assert!((-s.neg_q() as f64 - want).abs() <= 12.0, "{r}: {} vs {want}", -s.neg_q());
+            assert!(
+                (-s.neg_q() as f64 - want).abs() <= 12.0,
+                "{r}: {} vs {want}",
+                -s.neg_q()
+            );
         }
         // Saturated beyond the limit, never wrapped.
         assert_eq!(Sine::new(i32::MAX), Sine::new(RESIDUAL_LIMIT - 1));
@@ -119,7 +123,11 @@ mod tests {
                 (got - series).abs() <= 2.0 * RAD_PER_PHASE_LSB,
                 "{x}: {got} vs {series}"
             );
-            assert!((got - rr.asin()).abs() <= 1.3e-5, "{x}: {got} vs {}", rr.asin());
+            assert!(
+                (got - rr.asin()).abs() <= 1.3e-5,
+                "{x}: {got} vs {}",
+                rr.asin()
+            );
         }
         let beyond = Sine::new(RESIDUAL_LIMIT + 5);
         assert_eq!(beyond.n_lift, Sine::new(RESIDUAL_LIMIT - 1).n_lift);

@@ -1,10 +1,12 @@
 //! The estimators against the simulators' truth, over seeds: lock-in
 //! (lockin.rs), scale factor (scale_factor.rs), Allan terms and speed
-//! (allan.rs), discovery (discover_trials.rs, discover_summary.rs). Each
+//! (allan.rs), the eps^2 correction over the vibration envelope (eps2.rs),
+//! discovery (discover_trials.rs, discover_summary.rs). Each
 //! returns its figures; the bench command prints them.
 
 pub mod allan;
 pub mod discover_summary;
 pub mod discover_trials;
+pub mod eps2;
 pub mod lockin;
 pub mod scale_factor;

@@ -33,6 +33,8 @@ pub enum BenchCmd {
     Discover(DiscoverBenchArgs),
     /// The recorder on a ten-minute capture: the CPU it needs at the board's rate.
     Record(crate::cli::bench_record::RecordBenchArgs),
+    /// The online eps^2 correction over the vibration envelope: the table of issue 23.
+    Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
 }
 
 pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
@@ -43,6 +45,7 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::AllanSpeed(a) => allan_speed(a),
         BenchCmd::Discover(a) => discover(a),
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
+        BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
     }
 }
 
