@@ -151,7 +151,7 @@ pub fn run(
                     plan.max_seconds,
                     |p| {
                         blocks += 1;
-                        if blocks % 16 == 0 {
+                        if blocks.is_multiple_of(16) {
                             progress(Eps2Progress::Running {
                                 index: i,
                                 share_left_se: p.share_left_se(),
