@@ -116,13 +116,22 @@ pub fn run_bench(a: &Eps2BenchArgs) -> Result<(), LabError> {
     );
     if !a.json.json {
         println!("eps^2 correction over the envelope: {} points, each to a standard error of {:.3} % of the formula (at most {} simulated s), {threads} threads", points.len(), a.se * 100.0, a.max_s);
-        bar.println(&header);
+        if bar.is_hidden() {
+            println!("{header}");
+        } else {
+            bar.println(&header);
+        }
     }
     let running = Mutex::new(std::collections::BTreeMap::new());
     let progress = |p: Eps2Progress| match p {
         Eps2Progress::Done(i, r) => {
+            // A hidden bar (stderr not a terminal) prints nothing itself.
             if !a.json.json {
-                bar.println(row_line(&r));
+                if bar.is_hidden() {
+                    println!("{}", row_line(&r));
+                } else {
+                    bar.println(row_line(&r));
+                }
             }
             if let Ok(mut m) = running.lock() {
                 m.remove(&i);
