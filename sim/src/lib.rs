@@ -11,6 +11,7 @@ pub mod fog_thermal;
 pub mod noise;
 pub mod profile;
 pub mod rlg_rig;
+pub mod vibration_drift;
 
 pub use fog_optics::{Chain, FogOptics, OpticsParams};
 pub use fog_rig::FogRig;
@@ -18,3 +19,4 @@ pub use fog_thermal::{CoilThermal, ScaleFactorTruth};
 pub use noise::{NoiseParams, RateNoise};
 pub use profile::{Profile, Segment};
 pub use rlg_rig::{Chamber, ChamberParams, ChamberSample};
+pub use vibration_drift::{eps2_point, Drift, DriftMeter, Eps2Point};

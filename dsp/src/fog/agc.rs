@@ -6,6 +6,8 @@
 //! docs/fog.md, "AGC and the DC moment"), which would otherwise lower the
 //! loop gain under dynamics.
 
+use super::residual::Sine;
+use crate::fixed::smmul;
 use crate::phase::RAD_PER_PHASE_LSB;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
@@ -81,7 +83,7 @@ pub struct Agc {
 }
 
 /// The in-closure residual spread the DC moment is measured from: the
-/// demodulated sums, the slope and the residual (closure.rs).
+/// demodulated sums, the slope and the residual's sine (closure.rs).
 #[derive(Clone, Copy, Debug)]
 pub struct Spread {
     /// Sum of the first half's signed levels less the second's, LSB.
@@ -90,8 +92,9 @@ pub struct Spread {
     pub slope: i32,
     /// Minus the closure's signed level sum, LSB.
     pub neg_sum: i32,
-    /// Mean residual, phase LSB.
-    pub residual: i32,
+    /// Mean demodulated residual r (the sine), phase LSB, and r^2 in rad^2,
+    /// Q31 ([`Sine`]).
+    pub sine: Sine,
 }
 
 /// What one closure tells the AGC.
@@ -129,20 +132,36 @@ impl Agc {
     /// (the first after start or darkness seeds it with that flat value),
     /// or restarts it after darkness. Clipped closures are not fed: their
     /// levels are not true.
-    /// |diff| < 2^27, |slope * spread| < 2^29, |sum| < 2^27, |residual| <
-    /// 2^31: |m| < 2^58 and its high word below 2^26 (dropping the low word
-    /// costs under 1e-4 of the DC).
+    ///
+    /// The excess is `-A*cos(phi0)*n*E`, E = 1 - sqrt(1 - r^2 - S/(1 - r^2))
+    /// exactly (docs/fog.md, "AGC and the DC moment"): r the demodulated
+    /// residual, S the in-closure spread's share. With the levels' own
+    /// amplitude (neg_sum = A*sin(phi0)*n*r, diff = A*sin(phi0)*n*d/2),
+    /// `2E*A*sin(phi0)*n = neg_sum*(r + 3/2*(asin(r) - r)) + w*diff*d*(1 +
+    /// 3q/2)` to r^6 (0.02 % of E at r = 0.37), w = 2(n^2 - 1)/(3n^2),
+    /// q = r^2.
+    /// |diff| < 2^27, |slope * spread| < 2^29 (weighted below 2^30), |neg_sum|
+    /// < 2^27, the moment's residual below 1.1 * 2^28: |m| < 2^58 and its
+    /// high word below 2^26 (dropping the low word costs under 1e-4 of the
+    /// DC), so 16 times it fits an i32.
     #[inline(always)]
     pub fn update(&mut self, cfg: &AgcConfig, input: AgcInput) {
         let AgcInput::Lit { dc_half, spread: s } = input else {
             self.valid = false;
             return;
         };
-        let m = s.diff as i64 * s.slope.wrapping_mul(cfg.spread_q8) as i64
-            + s.neg_sum as i64 * s.residual as i64;
-        let excess = ((m >> 32) * cfg.moment_q60 as i64) >> 28;
+        // The spread's weight times 1 + 3q/2 = 1 - 9h (h = -q/6, Q32; |9h|
+        // < 0.24).
+        let h = s.sine.h;
+        let w = s.slope.wrapping_mul(cfg.spread_q8);
+        let w = w - smmul(w, h + (h << 3));
+        // r + 3/2*(asin(r) - r) (n_lift is minus the step to asin).
+        let r_m = s.sine.r - s.sine.n_lift - (s.sine.n_lift >> 1);
+        let m = s.diff as i64 * w as i64 + s.neg_sum as i64 * r_m as i64;
+        // Q60 weight: (m >> 32) * moment >> 28 = smmul(16 * (m >> 32), moment).
+        let excess = smmul(((m >> 32) as i32) << 4, cfg.moment_q60);
         let dc = dc_half.min(MAX_HALF_SUM) as i32;
-        let flat = (dc - excess as i32).clamp(0, MAX_HALF_SUM as i32) as u32;
+        let flat = (dc - excess).clamp(0, MAX_HALF_SUM as i32) as u32;
         self.dc_q12 = if self.valid {
             self.dc_q12 - (self.dc_q12 >> 12) + flat
         } else {
@@ -172,7 +191,11 @@ mod tests {
         diff: 0,
         slope: 0,
         neg_sum: 0,
-        residual: 0,
+        sine: Sine {
+            r: 0,
+            h: 0,
+            n_lift: 0,
+        },
     };
 
     fn lit(dc_half: u32, spread: Spread) -> AgcInput {
@@ -194,28 +217,43 @@ mod tests {
         assert!((got - expect).abs() < 1e-3, "{got} vs {expect}");
     }
 
-    /// The moment's excess is what the formula gives: at 3pi/4 a spread
-    /// raises the DC (cos(phi0) < 0), so the excess removed is positive.
+    /// The moment's excess is the exact DC excess of a closure whose
+    /// residual has sine r and slope d: `-cos(phi0)*A*E`, E = 1 - sqrt(1 -
+    /// r^2 - S/(1 - r^2)), S = (n^2 - 1)d^2/(3n^2), with the levels a
+    /// closure of amplitude A gives (neg_sum = A*sin(phi0)*n*r, diff =
+    /// A*sin(phi0)*n*d/2), to the series' 5e-4 at r = 0.35 rad. At 3pi/4 a
+    /// spread raises the DC (cos(phi0) < 0), so the excess removed is
+    /// positive; without a slope it is the residual's alone.
     #[test]
     fn moment_removes_the_spread_excess() {
         let (phi0, n) = (0.75 * PI, 16);
         let cfg = AgcConfig::new(8_000.0, 1_024.0, 3, phi0, n);
-        let s = Spread {
-            diff: 0,
-            slope: 0,
-            neg_sum: 1 << 20,
-            residual: 1 << 26,
-        };
-        let mut agc = Agc::new(&cfg);
-        agc.update(&cfg, lit(50_000, s));
-        let m = (s.neg_sum as f64) * (s.residual as f64);
-        let excess = m * -(1.0 / phi0.tan()) / (2.0 * n as f64) * RAD_PER_PHASE_LSB;
-        let removed = 50_000.0 - agc.dc() as f64;
-        assert!(excess > 0.0);
-        assert!(
-            (removed - excess).abs() <= 1.0 + 1e-3 * excess,
-            "{removed} vs {excess}"
-        );
+        let nf = n as f64;
+        for (r_rad, d_rad) in [(0.35, 0.05), (0.35, 0.0), (-0.2, 0.08), (0.01, 0.0)] {
+            let neg_sum = if r_rad < 0.0 { -(1 << 20) } else { 1 << 20 };
+            let a = neg_sum as f64 / (phi0.sin() * nf * r_rad);
+            let diff = (a * phi0.sin() * nf * d_rad / 2.0).round() as i32;
+            let r = (r_rad / RAD_PER_PHASE_LSB).round() as i32;
+            let slope = (d_rad / RAD_PER_PHASE_LSB / 256.0).round() as i32;
+            let s = Spread {
+                diff,
+                slope,
+                neg_sum,
+                sine: Sine::new(r),
+            };
+            let mut agc = Agc::new(&cfg);
+            agc.update(&cfg, lit(50_000, s));
+            let q = r_rad * r_rad;
+            let spread = (nf * nf - 1.0) * d_rad * d_rad / (3.0 * nf * nf);
+            let e = 1.0 - (1.0 - q - spread / (1.0 - q)).sqrt();
+            let excess = -phi0.cos() * a * e;
+            let removed = 50_000.0 - agc.dc() as f64;
+            assert!(excess > 0.0);
+            assert!(
+                (removed - excess).abs() <= 1.0 + 5e-4 * excess,
+                "r {r_rad} d {d_rad}: {removed} vs {excess}"
+            );
+        }
     }
 
     /// Until a lit closure is fed (at start, after clipped closures, after

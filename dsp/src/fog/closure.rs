@@ -16,6 +16,7 @@ use super::gain_loop::GainLoop;
 use super::layout::Kernel;
 use super::lock::LockDetector;
 use super::modulator::{Modulator, Resets};
+use super::residual::Sine;
 use super::vibration::VibrationCorrection;
 use crate::fixed::shr_saturate;
 
@@ -28,7 +29,8 @@ pub struct ClosureOutput {
     pub sagnac_phase: i64,
     /// `sagnac_phase` less the epsilon-squared bias estimate (equal when off).
     pub sagnac_phase_corrected: i64,
-    /// Demodulated mean residual of this closure, phase LSB.
+    /// Mean residual phase of this closure, phase LSB: asin of the
+    /// demodulated residual (residual.rs).
     pub residual: i32,
     /// Digital modulator gain (DAC codes per turn, Q8) from the 2*pi loop.
     pub codes_per_turn_q8: u32,
@@ -83,6 +85,24 @@ fn clamp_feedback(phase: i64) -> i64 {
         phase
     } else {
         (sat as i64) << 32 | (!(sat >> 31) as u32) as i64
+    }
+}
+
+/// `(neg_sum * gain + 2^15) >> 16` saturated to the i32 range: the
+/// residual (phase LSB) rounded to the nearest LSB. The unrounded product's
+/// high word decides the saturation, one step early at the top (2^16 LSB,
+/// 1e-4 rad short of half a turn, where the residual only says "far out"),
+/// so the rounding's carry cannot wrap: one `smull`, an add with carry and
+/// the high-word compare, no 64-bit clamp.
+#[inline(always)]
+fn round_residual(neg_sum: i32, gain: i32) -> i32 {
+    const LIM: i32 = 1 << 15;
+    let p = neg_sum as i64 * gain as i64;
+    let hi = (p >> 32) as i32;
+    if hi.clamp(-LIM, LIM - 2) == hi {
+        ((p + (1 << 15)) >> 16) as i32
+    } else {
+        (hi >> 31) ^ i32::MAX
     }
 }
 
@@ -226,18 +246,39 @@ impl FogLoop {
             // gain < 2^31: both products below 2^57. The residual saturates
             // at +-half a turn: the error is periodic, so an estimate beyond
             // that only says "far out" (lock acquisition then takes several
-            // closures, as it would anyway).
+            // closures, as it would anyway). Rounded: a floored residual
+            // would bias the output by half an LSB, since the loop nulls the
+            // mean of what it measures.
             let neg_sum = -(sums.first + sums.second);
-            residual = shr_saturate::<16, 32>(neg_sum as i64 * gain as i64);
+            let demodulated = round_residual(neg_sum, gain);
             // In-closure slope (second half's residual less the first's),
             // 2^-3 phase LSB, saturated to the i32 range (+-0.37 rad).
             let diff = sums.first - sums.second;
             let slope_q3 = shr_saturate::<12, 32>(diff as i64 * gain as i64);
+            // The demodulated residual is the sine of the residual phase:
+            // the loop and the output take asin of it (residual.rs), the
+            // correction and the AGC its square.
+            let sine = Sine::new(demodulated);
+            residual = sine.phase(demodulated);
 
             // Clipped samples still give the error's sign, so the main loop
             // keeps running through over-range (holding it could lock it
             // there); the gain loop, the correction and the AGC, which need
-            // true levels, pause.
+            // true levels, pause (the correction with a zero slope: no bias,
+            // its carried fraction kept, and no branch). The correction and
+            // the AGC first, while the residual's sine is in registers.
+            let slope_true = if adc_over_range { 0 } else { slope_q3 };
+            bias = self.vibration.update(&cfg.vibration, slope_true, &sine);
+            if !adc_over_range {
+                let spread = Spread {
+                    diff,
+                    // The slope in 2^8 LSB, saturated at +-2^20.
+                    slope: slope_q3 >> 11,
+                    neg_sum,
+                    sine,
+                };
+                self.agc.update(&cfg.agc, AgcInput::Lit { dc_half, spread });
+            }
             measured = applied + residual as i64;
             let correction = if LATENCY == 0 {
                 // |residual| < 2^31, gain < 2^17 (Q16 below 2): one 32x32 product.
@@ -263,15 +304,6 @@ impl FogLoop {
                     residual,
                     recip_h,
                 );
-                bias = self.vibration.update(&cfg.vibration, slope_q3, residual);
-                let spread = Spread {
-                    diff,
-                    // The slope in 2^8 LSB, saturated at +-2^20.
-                    slope: slope_q3 >> 11,
-                    neg_sum,
-                    residual,
-                };
-                self.agc.update(&cfg.agc, AgcInput::Lit { dc_half, spread });
             }
             if let Some(lost) = self.lock.update(&cfg.lock, residual) {
                 self.faults.set(Faults::OUT_OF_LOCK, lost);
@@ -302,7 +334,42 @@ impl FogLoop {
 
 #[cfg(test)]
 mod tests {
-    use super::{clamp_feedback, FEEDBACK_LIMIT};
+    use super::{clamp_feedback, round_residual, FEEDBACK_LIMIT};
+
+    /// The rounded residual is the nearest integer of the product / 2^16,
+    /// saturated: exact wherever it fits, half-LSB ties up, and at most
+    /// 2^16 LSB early at the top.
+    #[test]
+    fn residual_rounds_to_nearest_and_saturates() {
+        let reference = |a: i32, g: i32| {
+            let x = (a as i64 * g as i64) as f64 / 65_536.0;
+            (x + 0.5).floor().clamp(i32::MIN as f64, i32::MAX as f64) as i64
+        };
+        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+        for k in 0..200_000u32 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let a = (x as i32) >> (k % 24);
+            let g = ((x >> 32) as i32 & i32::MAX) >> (k % 8);
+            let got = round_residual(a, g) as i64;
+            let want = reference(a, g);
+            if want < (1 << 31) - (1 << 16) {
+                assert_eq!(got, want, "{a} * {g}");
+            } else {
+                assert!(
+                    got == i32::MAX as i64 && want - got <= 1 << 16,
+                    "{a} * {g}: {got} vs {want}"
+                );
+            }
+        }
+        assert_eq!(round_residual(1, 1 << 15), 1);
+        assert_eq!(round_residual(1, (1 << 15) - 1), 0);
+        assert_eq!(round_residual(-1, 1 << 15), 0);
+        assert_eq!(round_residual(-1, (1 << 15) + 1), -1);
+        assert_eq!(round_residual(1 << 26, i32::MAX), i32::MAX);
+        assert_eq!(round_residual(-(1 << 26), i32::MAX), i32::MIN);
+    }
 
     /// The high-word clamp equals the plain 64-bit clamp everywhere, the
     /// edges and the whole i64 range included.

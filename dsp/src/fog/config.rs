@@ -64,6 +64,13 @@ pub struct FogParams {
     /// ADC reading with no light (detector dark output plus ADC offset), LSB per
     /// sample; the front end sits above zero so a dark fringe is not clipped.
     pub dark_lsb: f64,
+    /// Detector (front end) response time, s: at each modulation edge the
+    /// phase difference sweeps through the bright fringe, and the kept
+    /// samples still carry exp(-t/detector_tau_s) of that glitch. It adds a
+    /// DC the AGC would read as light (0.2 % at 7pi/8 with one of four
+    /// samples skipped); the error scale takes it out (docs/fog.md, "AGC and
+    /// the DC moment"). 0: an ideal detector.
+    pub detector_tau_s: f64,
 }
 
 impl Default for FogParams {
@@ -88,6 +95,7 @@ impl Default for FogParams {
             vibration_correction: true,
             nominal_dc_lsb: 8_000.0,
             dark_lsb: 1_024.0,
+            detector_tau_s: 0.15e-6,
         }
     }
 }
@@ -162,7 +170,9 @@ impl FogConfig {
             && finite_pos(p.tau_s)
             && finite_pos(p.closure_hz)
             && finite_pos(p.nominal_dc_lsb)
-            && p.dark_lsb.is_finite())
+            && p.dark_lsb.is_finite()
+            && p.detector_tau_s.is_finite()
+            && p.detector_tau_s >= 0.0)
         {
             return Err(ConfigError::Physical);
         }
@@ -209,32 +219,53 @@ impl FogConfig {
         );
         let dither =
             DitherConfig::new(p.dither_adc_codes, p.adc_bits, p.nominal_dc_lsb, p.phi0_rad);
-        let vibration = VibrationConfig::new(p.vibration_correction, p.phi0_rad, n_half)
-            .ok_or(ConfigError::VibrationCoeff)?;
+        let vibration = VibrationConfig::new(
+            p.vibration_correction,
+            p.phi0_rad,
+            n_half,
+            dither.mean_square(),
+        )
+        .ok_or(ConfigError::VibrationCoeff)?;
         let gain_loop =
             GainLoopConfig::new(p.gain_loop_gain, p.dac_codes_per_turn, p.phi0_rad, n_half);
 
         // Residual per normalised demodulator count. With depth phi0 + r (the
         // dither) the error slope is A*sin(phi0 + r), which the closure scales
-        // by 1 - r*cot(phi0), and the DC A*(1 + cos(phi0 + r)). Over a uniform
-        // dither of half width w the mean slope is A*sin(phi0)*G, G = <cos r> -
-        // cot^2(phi0)*<r sin r> = sin(w)/w - cot^2(phi0)*(sin w - w cos w)/w,
-        // and the DC A*(1 + c*sin(w)/w) (c = cos phi0), so the unit-gain scale
-        // is cot(phi0/2)/n times (1 + c*sin(w)/w)/((1 + c)*G) (docs/fog.md,
+        // by 1 - r*cot(phi0), and the DC A*(1 + cos(phi0 + r)). Over the
+        // dither (triangular, [`DitherConfig::mean_cos`]) the mean slope is
+        // A*sin(phi0)*G, G = <cos r> - cot^2(phi0)*<r sin r>, and the DC
+        // A*(1 + c*<cos r>) (c = cos phi0), so the unit-gain scale is
+        // cot(phi0/2)/n times (1 + c*<cos r>)/((1 + c)*G) (docs/fog.md,
         // "Depth dither"). The residual's own spread moves the DC the same
         // way; the AGC's DC moment removes that.
         let cot_half = 1.0 / (p.phi0_rad / 2.0).tan();
         let cot_phi0 = 1.0 / p.phi0_rad.tan();
         let c = p.phi0_rad.cos();
         let w = dither.half_width_rad();
-        let (sinc, r_sin) = if w > 0.0 {
-            (w.sin() / w, (w.sin() - w * w.cos()) / w)
+        let sinc = dither.mean_cos();
+        let slope_mean = sinc - cot_phi0 * cot_phi0 * dither.mean_r_sin();
+        // The detector's settling: sample i of a half period (t = i*tau/spp)
+        // reads level*(1 - e_i) + P0*e_i, e_i = exp(-t/detector_tau), P0 =
+        // 2A the bright fringe the edge swept through. The kept sum is then
+        // A*(1 + c)*(kept - e) + 2A*e (e the kept samples' sum of e_i), the
+        // slope A*sin(phi0)*(kept - e): the normalised error is short by
+        // 1 + 2e/((1 + c)(kept - e)), which the scale restores. Left in, it
+        // is a loop gain error the AGC's DC moment amplifies under
+        // vibration (by 1/(1 - excess share), docs/fog.md).
+        let settle: f64 = if p.detector_tau_s > 0.0 {
+            (p.skip_samples..p.samples_per_half)
+                .map(|i| {
+                    (-(i as f64) * p.tau_s / p.samples_per_half as f64 / p.detector_tau_s).exp()
+                })
+                .sum()
         } else {
-            (1.0, 0.0)
+            0.0
         };
-        let slope_mean = sinc - cot_phi0 * cot_phi0 * r_sin;
+        let kept = kept_per_half as f64;
+        let settle_gain = 1.0 + 2.0 * settle / ((1.0 + c * sinc) * (kept - settle));
         let per_count = cot_half * PHASE_LSB_PER_RAD / n_half as f64 * (1.0 + c * sinc)
-            / ((1.0 + c) * slope_mean);
+            / ((1.0 + c) * slope_mean)
+            * settle_gain;
         // The closure scales the error by per_count * (2^32/H) / 2^16 with H
         // >= h0_min; below 2^31 its products with the closure's sums (below
         // 2^27) are single 32x32 multiplies. That needs the operating point's

@@ -23,6 +23,7 @@ pub mod gain_loop;
 pub mod layout;
 pub mod lock;
 mod modulator;
+pub mod residual;
 pub mod scale_factor;
 pub mod vibration;
 

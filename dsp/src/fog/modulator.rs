@@ -101,10 +101,7 @@ impl Modulator {
             theta = t2;
             plus = (plus << 1) | (s1 >> 32) as u32;
             minus = (minus << 1) | (s2 >> 32) as u32;
-            if let [p, m] = pair {
-                *p = dac_word(t1, cpt);
-                *m = dac_word(t2, cpt);
-            }
+            pair.copy_from_slice(&[dac_word(t1, cpt), dac_word(t2, cpt)]);
         }
         self.theta = theta;
         (plus, minus)

@@ -1,6 +1,7 @@
 //! The estimators against the simulators' truth, over seeds: lock-in
 //! (lockin.rs), scale factor (scale_factor.rs), Allan terms and speed
-//! (allan.rs), discovery (discover_trials.rs, discover_categories.rs,
+//! (allan.rs), the eps^2 correction over the vibration envelope (eps2.rs),
+//! discovery (discover_trials.rs, discover_categories.rs,
 //! discover_summary.rs; discover_heldout.rs scores the second generator's
 //! held-out set). Each returns its figures; the bench command prints them.
 
@@ -9,5 +10,6 @@ pub mod discover_categories;
 pub mod discover_heldout;
 pub mod discover_summary;
 pub mod discover_trials;
+pub mod eps2;
 pub mod lockin;
 pub mod scale_factor;

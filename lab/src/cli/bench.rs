@@ -37,6 +37,8 @@ pub enum BenchCmd {
     Record(crate::cli::bench_record::RecordBenchArgs),
     /// Discovery on the second generator's held-out set (`simulate heldout`): right, false names, coverage.
     DiscoverHeldout(HeldOutBenchArgs),
+    /// The online eps^2 correction over the vibration envelope: the table of issue 23.
+    Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
 }
 
 pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
@@ -48,6 +50,7 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::Discover(a) => discover(a),
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
         BenchCmd::DiscoverHeldout(a) => discover_heldout(a),
+        BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
     }
 }
 

@@ -43,6 +43,8 @@ pub struct FogRunParams {
     pub dither_codes: f64,
     /// Start-up time left out of the mean error, s.
     pub settle_s: f64,
+    /// DAC latency, closures (0 or 1: the hw board's DMA ping-pong).
+    pub dac_latency: u32,
 }
 
 /// A parameter of the run checked against its range.
@@ -54,6 +56,7 @@ pub enum FogRunParam {
     VibrationLevels,
     VibrationDps2,
     VibrationHz,
+    DacLatency,
 }
 
 /// Why a run cannot be made, in the order the parameters are checked.
@@ -180,8 +183,8 @@ fn profile(p: &FogRunParams, levels: &[f64]) -> Result<(Profile<f64>, Option<f64
 }
 
 impl FogRun {
-    /// Checks the parameters (in this order: duration, rate, ADC bits, the
-    /// loop configuration, the vibration levels, acceleration and
+    /// Checks the parameters (in this order: duration, rate, ADC bits, DAC
+    /// latency, the loop configuration, the vibration levels, acceleration and
     /// frequency, the length against one period) and plans the run.
     pub fn new(p: &FogRunParams) -> Result<Self, FogRunError> {
         let d = p.duration_s;
@@ -189,6 +192,8 @@ impl FogRun {
         check(FogRunParam::Rate, p.rate_dps, p.rate_dps.abs() <= 2000.0)?;
         let bits = p.adc_bits;
         check(FogRunParam::AdcBits, bits as f64, (8..=16).contains(&bits))?;
+        let lat = p.dac_latency;
+        check(FogRunParam::DacLatency, lat as f64, lat <= 1)?;
         let params = FogParams {
             phi0_rad: p.phi0_rad,
             closure_hz: p.closure_hz,
@@ -196,6 +201,7 @@ impl FogRun {
             gain_loop_gain: p.gain_loop_gain,
             dither_adc_codes: p.dither_codes,
             vibration_correction: p.vibration_correction,
+            dac_latency: p.dac_latency,
             ..FogParams::default()
         };
         let mut optics = OpticsParams::<f64>::nominal(

@@ -64,6 +64,11 @@ pub struct FogArgs {
     /// Start-up time left out of the mean error, s.
     #[arg(long, default_value_t = 0.02)]
     pub settle_s: f64,
+    /// DAC latency, closures: 1 simulates the hw board's DMA ping-pong (the
+    /// words computed in one closure drive the modulator in the next), as
+    /// the rig does; 0 (QEMU, the host rigs) applies them at once.
+    #[arg(long, default_value_t = 0, value_name = "CLOSURES")]
+    pub dac_latency: u32,
     #[command(flatten)]
     pub out: OutOpt,
     #[command(flatten)]
@@ -91,6 +96,7 @@ impl FogArgs {
             adc_bits: self.adc_bits,
             dither_codes: self.dither_codes,
             settle_s: self.settle_s,
+            dac_latency: self.dac_latency,
         }
     }
 }
@@ -105,6 +111,7 @@ fn usage(e: FogRunError) -> LabError {
                 FogRunParam::VibrationLevels => "vibration-levels",
                 FogRunParam::VibrationDps2 => "vibration-dps2",
                 FogRunParam::VibrationHz => "vibration-hz",
+                FogRunParam::DacLatency => "dac-latency",
             };
             format!("--{name} {v}: out of range")
         }
