@@ -252,7 +252,14 @@ fn search(c: &Curve, what: Searched, active: &[bool; ALL], sh: &Shapes, w: &[f64
 /// scan of +-2/tau_L around the last stage's best at 1/(16 tau_L) and a
 /// golden section about the best; then tau_L four times longer. Kept only
 /// if it lowers the whole curve's cost.
-fn refine_frequency(c: &Curve, active: &[bool; ALL], sh: &Shapes, w: &[f64], f0: f64, cost0: f64) -> f64 {
+fn refine_frequency(
+    c: &Curve,
+    active: &[bool; ALL],
+    sh: &Shapes,
+    w: &[f64],
+    f0: f64,
+    cost0: f64,
+) -> f64 {
     let mut trial = *sh;
     let mut at = |sub: &Curve, wk: &[f64], f: f64| {
         trial.f = f;
