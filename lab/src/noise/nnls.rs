@@ -140,7 +140,7 @@ mod tests {
         let cols: Vec<Vec<f64>> = vec![
             t.iter().map(|t| 1.0 / t).collect(),
             t.iter().map(|_| 1.0).collect(),
-            t.iter().copied().collect(),
+            t.to_vec(),
             t.iter().map(|t| t * t).collect(),
         ];
         let y: Vec<f64> = (0..n)
