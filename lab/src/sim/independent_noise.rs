@@ -17,9 +17,19 @@
 //!   sample, averaged; a ramp R t;
 //! - a sinusoid: the exact mean of A sin(2 pi f t + phi) over each period;
 //! - quantization: a true quantizer of the accumulated angle (angle
-//!   counts of `quantum_deg`; the rate is the count difference times the
-//!   quantum over tau0), which leaves white angle noise of Q = quantum /
-//!   sqrt(12) when the noise moves the angle over many counts per sample.
+//!   counts of `quantum` = Q sqrt(12)) read through a stripped dither, as
+//!   a ring-laser gyro's body dither is: a known random angle, uniform over
+//!   whole quanta and new at every sample, is added before the counter and
+//!   taken off its reading. The angle error is then uniform over one
+//!   quantum, independent of the signal and from sample to sample
+//!   (Schuchman 1964, subtractive dither): white angle noise of variance
+//!   quantum^2 / 12 = Q^2, whose Allan variance is IEEE 952's 3 Q^2 /
+//!   tau^2 whatever the rate does. Without the dither the error is white
+//!   only when the rate moves the angle over many counts per sample; on a
+//!   nearly still angle (a sinusoid of 20 deg/h at 0.1 Hz swings 0.018 deg
+//!   peak to peak, less than the 0.019 deg quantum of Q = 20 arcsec) the
+//!   counter's error follows the signal instead, and the record has no
+//!   3 Q^2 / tau^2 part at that Q (its -1 slope read Q = 12 there).
 
 use crate::noise::terms::COUNT;
 use num_complex::Complex;
@@ -153,14 +163,20 @@ pub fn record(truth: &Truth, n: usize, tau0: f64, seed: u64) -> Vec<f64> {
     }
     if q_arcsec > 0.0 {
         let quantum = q_arcsec / 3600.0 * 12f64.sqrt();
+        // The dither's span, in quanta (any whole number leaves the error
+        // uniform over one quantum).
+        const DITHER_QUANTA: f64 = 8.0;
+        let mut dither = || rng.uniform() * DITHER_QUANTA * quantum;
         // The counter's phase at the start is arbitrary.
-        let mut angle = rng.uniform() * quantum;
-        let mut last = (angle / quantum).floor();
+        let mut angle = 0.0;
+        let d = dither();
+        let mut last = ((angle + d) / quantum).floor() * quantum - d;
         for v in y.iter_mut() {
             angle += *v * tau0;
-            let count = (angle / quantum).floor();
-            *v = (count - last) * quantum / tau0;
-            last = count;
+            let d = dither();
+            let read = ((angle + d) / quantum).floor() * quantum - d;
+            *v = (read - last) / tau0;
+            last = read;
         }
     }
     y
