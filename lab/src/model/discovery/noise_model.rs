@@ -41,6 +41,11 @@ const FLICKER_SPACING: f64 = 3.162_277_660_168_379_5;
 /// Shortest flicker correlation time, s (faster ones are white in a 1 s mean).
 const FLICKER_MIN_S: f64 = 2.0;
 
+/// Fewest windows whose scatter the noise's colour is measured from (the
+/// Allan fit of [`NoiseModel::from_residual`] and the likelihood of
+/// [`refine`]); a shorter record is a short one (docs/discovery.md).
+pub const MIN_COLOUR_WINDOWS: usize = 64;
+
 /// The noise of the residual's window means.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct NoiseModel {
@@ -81,6 +86,43 @@ impl NoiseModel {
         }
     }
 
+    /// White noise from the scatter of the residual's own samples within
+    /// each window (neighbours' differences, so no slow shape enters),
+    /// as the variance of a full window's mean: on a record too short for
+    /// its window means to show their noise, the one level the samples
+    /// still measure. The mean square difference, its largest 1 % left out
+    /// (a table's rate step), over the share of a Gaussian's chi-square(1)
+    /// mean below its 99 % quantile (P(chi2_3 < 6.635) / 0.99).
+    pub fn white_of_samples(r: &[f64], win: &Windows) -> Option<Self> {
+        let mut d2: Vec<f64> = (1..r.len().min(win.idx.len()))
+            .filter(|&k| win.idx[k] == win.idx[k - 1])
+            .map(|k| (r[k] - r[k - 1]).powi(2))
+            .filter(|v| v.is_finite())
+            .collect();
+        if d2.len() < 10 {
+            return None;
+        }
+        d2.sort_by(f64::total_cmp);
+        let kept = &d2[..(d2.len() as f64 * 0.99).ceil() as usize];
+        let ms = kept.iter().sum::<f64>() / kept.len() as f64;
+        let var = ms / (2.0 * 0.915_508 / 0.99);
+        let mut counts = win.count.clone();
+        counts.sort_by(f64::total_cmp);
+        let nominal = counts
+            .get(counts.len() / 2)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1.0);
+        let white = var / nominal;
+        (white > 0.0).then_some(Self {
+            white,
+            flicker: 0.0,
+            random_walk: 0.0,
+            markov: 0.0,
+            markov_s: 1.0,
+        })
+    }
+
     /// From the Allan variance of a residual's window means `means` (the
     /// windows `keep` says; spikes left out), `tau0` s apart: the IEEE 952
     /// terms fitted by [`fit_terms`] to the curve up to a tenth of the
@@ -96,7 +138,7 @@ impl NoiseModel {
             .map(|(v, _)| *v)
             .collect();
         let white = Self::white_of(means, keep);
-        if m.len() < 64 {
+        if m.len() < MIN_COLOUR_WINDOWS {
             return white;
         }
         // Averaging times up to a fifth of the record: beyond, the few
