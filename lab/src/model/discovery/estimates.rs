@@ -138,6 +138,25 @@ pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
     })
 }
 
+/// Widens `fin`'s intervals to hold, about its own values, those of
+/// `other` (the same terms fitted under another noise model: one whose
+/// slow noise the record cannot exclude) about its values: each side the
+/// larger distance.
+pub fn widen(fin: &mut Final, other: &Final) {
+    for (a, b) in fin.estimates.iter_mut().zip(&other.estimates) {
+        let (Some(a), Some(b)) = (a, b) else {
+            continue;
+        };
+        for (p, q) in a.params.iter_mut().zip(&b.params) {
+            let (below, above) = (q.1 - q.2, q.3 - q.1);
+            if below.is_finite() && above.is_finite() {
+                p.2 = p.2.min(p.1 - below);
+                p.3 = p.3.max(p.1 + above);
+            }
+        }
+    }
+}
+
 /// The unscaled covariance of every linear coefficient (first, in the
 /// fit's column order) and of the non-linear parameters (after, for the
 /// terms listed, in ln x where the search is logarithmic): (cov, terms with

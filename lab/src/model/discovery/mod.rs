@@ -271,6 +271,34 @@ fn short_record(d: &Design, sel: &Selection) -> Option<String> {
     ))
 }
 
+/// The intervals widened for the slow noise the record cannot exclude:
+/// the flicker and the random walk the restricted likelihood still allows
+/// at 95 % (noise_model.rs's `slow_bounds`), each in turn, the final terms
+/// refitted on the problem whitened by it. A slow level fitted as nothing
+/// (white noise hides a bias instability at every averaging time the Allan
+/// curve measures well) otherwise leaves a slow regressor's interval
+/// that of white noise.
+fn allow_slow_noise(d: &Design, terms: &[Term], noise: &NoiseModel, fin: &mut estimates::Final) {
+    let (cols, y) = d.raw_problem(terms);
+    for up in noise_model::slow_bounds(noise, d.win, &d.wh.keep, &y, &cols) {
+        if up == *noise {
+            continue;
+        }
+        let mut du = Design::new(
+            d.inp,
+            d.win,
+            d.extent,
+            d.r.clone(),
+            Whitener::new(&up, d.win, &d.wh.keep),
+            d.steps.clone(),
+        );
+        du.phi = d.phi;
+        if let Some(f) = estimate(&du, terms) {
+            estimates::widen(fin, &f);
+        }
+    }
+}
+
 /// A model effect from an estimate's values.
 fn model_effect(e: &Estimate) -> ModelEffect {
     ModelEffect {
@@ -345,7 +373,12 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     let short = short_record(&d, &sel);
     let (role, amb_const, _) = constant::role(&d, &sel, &cands);
     let terms = sel.terms();
-    let fin = estimate(&d, &terms);
+    let mut fin = estimate(&d, &terms);
+    if short.is_none() {
+        if let Some(f) = fin.as_mut() {
+            allow_slow_noise(&d, &terms, &noise, f);
+        }
+    }
     let est = |j: usize| -> Option<Estimate> {
         fin.as_ref()
             .and_then(|f| f.estimates.get(j).cloned().flatten())

@@ -270,10 +270,98 @@ pub fn fit_terms(
     best
 }
 
+/// The restricted log-likelihood of noise model `m` for the residual
+/// less fixed parts `y` and a fit's raw columns `cols` (window means), the
+/// white level profiled out as the common scale.
+fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64>]) -> f64 {
+    let w = Whitener::new(m, win, keep);
+    let yw = w.whiten(y);
+    let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
+    let sse = match super::normal::normal_solve(&cw, &yw) {
+        Some(b) if !cw.is_empty() => {
+            let mut r = yw.clone();
+            for (c, bj) in cw.iter().zip(&b) {
+                for (a, v) in r.iter_mut().zip(c) {
+                    *a -= bj * v;
+                }
+            }
+            r.iter().map(|v| v * v).sum::<f64>()
+        }
+        _ => yw.iter().map(|v| v * v).sum::<f64>(),
+    };
+    // The restricted likelihood (REML): the fit's p columns take p
+    // degrees of freedom of the residual, and their Gram determinant
+    // weighs how much of each slow noise level they can absorb. Plain
+    // maximum likelihood (n in place of n - p, no determinant) reads the
+    // slow noise the fitted shapes soaked up as absent, and the slow
+    // levels, and with them the intervals, came out too small.
+    let n = w.used() as f64;
+    let p = cw.len() as f64;
+    let gram = if cw.is_empty() {
+        Some(0.0)
+    } else {
+        gram_log_det(&cw)
+    };
+    let Some(gram) = gram else {
+        return f64::NEG_INFINITY;
+    };
+    let m = (n - p).max(1.0);
+    -0.5 * (m * (sse / m).max(1e-300).ln() + w.log_det() + gram)
+}
+
+/// Half the chi-square(1) 95 % quantile: the fall of the log-likelihood
+/// at a level's 95 % profile bound.
+const HALF_CHI2_1_95: f64 = 1.920_729_410_347_062;
+
+/// The noise model with, in turn, its flicker and its random walk raised
+/// to the largest level the record cannot exclude (restricted likelihood
+/// within [`HALF_CHI2_1_95`] of `m`'s, the level scanned up in eighths of
+/// a decade from `m`'s, or a ten-thousandth of the white level, to a
+/// thousand times that): the slow noise a fit's intervals must allow for
+/// when the Allan curve and the likelihood cannot tell it from none.
+pub fn slow_bounds(
+    m: &NoiseModel,
+    win: &Windows,
+    keep: &[bool],
+    y: &[f64],
+    cols: &[Vec<f64>],
+) -> Vec<NoiseModel> {
+    let l0 = reml(m, win, keep, y, cols);
+    let floor = m.white * 1e-4;
+    (0..2)
+        .map(|which| {
+            let base = if which == 0 {
+                m.flicker.max(floor)
+            } else {
+                m.random_walk.max(floor * 1e-3)
+            };
+            let mut best = l0;
+            let mut up = *m;
+            for k in 1..=24 {
+                let mut c = *m;
+                let v = base * 10f64.powf(0.125 * k as f64);
+                if which == 0 {
+                    c.flicker = v;
+                } else {
+                    c.random_walk = v;
+                }
+                let l = reml(&c, win, keep, y, cols);
+                best = best.max(l);
+                if l < best - HALF_CHI2_1_95 {
+                    break;
+                }
+                up = c;
+            }
+            up
+        })
+        .collect()
+}
+
 /// The noise model, given the terms of a fit (their raw columns `cols`
 /// and the residual less their fixed parts `y`, window means), with its
-/// random walk, flicker and Markov levels refined by maximum likelihood
-/// (each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
+/// random walk, flicker and Markov levels refined by restricted maximum
+/// likelihood (REML: the likelihood of the residual's contrasts the fit's
+/// columns leave; each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
 /// twice; the white level profiled out as the common scale).
 pub fn refine(
     start: &NoiseModel,
@@ -282,25 +370,7 @@ pub fn refine(
     y: &[f64],
     cols: &[Vec<f64>],
 ) -> NoiseModel {
-    let loglik = |m: &NoiseModel| -> f64 {
-        let w = Whitener::new(m, win, keep);
-        let yw = w.whiten(y);
-        let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
-        let sse = match super::normal::normal_solve(&cw, &yw) {
-            Some(b) if !cw.is_empty() => {
-                let mut r = yw.clone();
-                for (c, bj) in cw.iter().zip(&b) {
-                    for (a, v) in r.iter_mut().zip(c) {
-                        *a -= bj * v;
-                    }
-                }
-                r.iter().map(|v| v * v).sum::<f64>()
-            }
-            _ => yw.iter().map(|v| v * v).sum::<f64>(),
-        };
-        let n = w.used() as f64;
-        -0.5 * (n * (sse / n).max(1e-300).ln() + w.log_det())
-    };
+    let loglik = |m: &NoiseModel| reml(m, win, keep, y, cols);
     let mut m = *start;
     let floor = m.white * 1e-4;
     let mut best = loglik(&m);
@@ -330,6 +400,22 @@ pub fn refine(
         }
     }
     m
+}
+
+/// ln det of the Gram matrix of `cols` (None when it is singular).
+fn gram_log_det(cols: &[Vec<f64>]) -> Option<f64> {
+    let m = cols.len();
+    let g = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        cols[i]
+            .iter()
+            .zip(&cols[j])
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+    });
+    let c = g.cholesky()?;
+    let l = c.l_dirty();
+    let s: f64 = (0..m).map(|i| 2.0 * l[(i, i)].ln()).sum();
+    s.is_finite().then_some(s)
 }
 
 /// The Kalman filter's gains for a noise model over a run's windows: it
