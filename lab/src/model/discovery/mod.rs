@@ -265,9 +265,10 @@ fn short_record(d: &Design, sel: &Selection) -> Option<String> {
         return None;
     }
     let p: usize = sel.terms().iter().map(|t| t.kind.dof()).sum();
+    let dof = n.saturating_sub(p);
     Some(format!(
-        "the record has {n} windows of {WINDOW_S} s, fewer than the {MIN_COLOUR_WINDOWS} its noise's colour is measured from: the intervals are unreliable (they assume white noise, at least the level its samples' scatter shows, with Student's t on {} degrees of freedom, and cannot see slower noise); record longer for intervals to rely on",
-        n.saturating_sub(p)
+        "the record has {n} windows of {WINDOW_S} s, fewer than the {MIN_COLOUR_WINDOWS} its noise's colour is measured from: the intervals are unreliable (they assume white noise, at least the level its samples' scatter shows, with Student's t on {dof} degree{} of freedom, and cannot see slower noise); record longer for intervals to rely on",
+        if dof == 1 { "" } else { "s" }
     ))
 }
 
