@@ -361,3 +361,91 @@ fn bad_input_is_one_line_and_exit_2() {
         "{skipped:?}"
     );
 }
+
+/// A short table run (3 s at 100 Hz: three 1 s windows, the table at 0,
+/// +20, -20 deg/s, as short as the recorded QEMU run) with a bias, a scale-factor error and white noise
+/// of `sigma` deg/s per sample; returns the file and the white-noise
+/// least-squares standard errors of the bias (deg/h) and of the
+/// scale-factor error (ppm) on the samples, with that sigma known.
+fn short_table_run(path: &std::path::Path, seed: u64, sigma: f64) -> (f64, f64) {
+    use rand_distr::{Distribution, StandardNormal};
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let (bias_dph, sf_ppm) = (40.0, 500.0);
+    let mut s = String::from("t_s,ref_rate_dps,rate_dps,temp_c\n");
+    let (mut n, mut sx, mut sxx) = (0.0, 0.0, 0.0);
+    for k in 0..300 {
+        let t = 0.01 * (k as f64 + 1.0);
+        let rate = [0.0, 20.0, -20.0][k / 100];
+        let z: f64 = StandardNormal.sample(&mut rng);
+        let y = rate * (1.0 + sf_ppm * 1e-6) + bias_dph / 3600.0 + sigma * z;
+        s.push_str(&format!("{t:.3},{rate},{y:.9},25.0\n"));
+        n += 1.0;
+        sx += rate;
+        sxx += rate * rate;
+    }
+    std::fs::write(path, s).unwrap();
+    // (X'X)^-1 of the columns [1, rate].
+    let det = n * sxx - sx * sx;
+    (
+        sigma * (sxx / det).sqrt() * 3600.0,
+        sigma * (n / det).sqrt() * 1e6,
+    )
+}
+
+#[test]
+fn a_short_record_has_intervals_at_least_as_wide_as_white_noise_gives() {
+    // Three windows: too few for the noise's colour, so the tool says its
+    // intervals are unreliable; still, no interval may be narrower than
+    // the standard error a white-noise least-squares fit of the samples
+    // gives (the noise that made the record is white).
+    let d = dir("short");
+    let p = |x: &std::path::Path| x.display().to_string();
+    for seed in 1..=4u64 {
+        let run = d.join(format!("short{seed}.csv"));
+        let (se_bias, se_sf) = short_table_run(&run, seed, 0.005);
+        let (code, out, err) = lab(&[
+            "discover",
+            "--gyro",
+            "fog",
+            "--data",
+            &p(&run),
+            "--out",
+            &p(&d.join(format!("o{seed}"))),
+            "--json",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let v = json(&out);
+        assert_eq!(v["intervals_reliable"], false, "{v}");
+        assert!(v["intervals_note"].as_str().unwrap().contains("unreliable"));
+        assert!(
+            v["gap_after_dph"].as_f64().unwrap() <= v["gap_before_dph"].as_f64().unwrap(),
+            "{v}"
+        );
+        let mut checked = 0;
+        for e in v["found"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .chain(v["carried"].as_array().unwrap())
+        {
+            for (name, iv) in e["parameter_intervals"].as_object().unwrap() {
+                let se = match name.as_str() {
+                    "bias_dph" => se_bias,
+                    "error_ppm" => se_sf,
+                    _ => continue,
+                };
+                // An effect written with its value has an interval: the fit
+                // leaves the residual degrees of freedom to measure it by.
+                let (Some(lo), Some(hi)) = (iv[0].as_f64(), iv[1].as_f64()) else {
+                    panic!("seed {seed}: {name} has no interval: {v}");
+                };
+                assert!(
+                    (hi - lo) / 2.0 >= se,
+                    "seed {seed}: {name} [{lo}, {hi}] narrower than the white-noise standard error {se}: {v}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 1, "no bias or scale-factor interval: {v}");
+    }
+}

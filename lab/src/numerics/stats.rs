@@ -4,6 +4,19 @@
 
 use statrs::function::gamma::gamma_lr;
 
+/// The two-sided 95 % quantile of Student's t with `dof` degrees of
+/// freedom (NaN below one: no scatter left to measure a variance from).
+pub fn t_975(dof: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    if dof.is_nan() || dof < 1.0 {
+        return f64::NAN;
+    }
+    if dof > 1e7 {
+        return 1.959_963_984_540_054;
+    }
+    StudentsT::new(0.0, 1.0, dof).map_or(f64::NAN, |t| t.inverse_cdf(0.975))
+}
+
 /// The `p` quantile of chi-square with `k` degrees of freedom (k > 0).
 /// Bisection on the regularized incomplete gamma function; above 10^4
 /// degrees of freedom the Wilson-Hilferty cube (relative error below 1e-6

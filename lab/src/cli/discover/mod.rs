@@ -151,6 +151,8 @@ pub fn json(d: &Discovery) -> serde_json::Value {
             "passes": d.passes,
         },
         "fallback": d.fallback,
+        "intervals_reliable": d.short.is_none(),
+        "intervals_note": d.short,
         "windows": d.windows.len(),
         "gyro": d.gyro.name(),
     })
@@ -275,6 +277,9 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
                 names.join(", ")
             );
         }
+    }
+    if let Some(s) = &d.short {
+        println!("short record: {s}");
     }
     for e in &d.found {
         println!(

@@ -36,6 +36,10 @@ pub struct Design<'a> {
     /// Variance inflation for the correlation the noise model leaves in
     /// the whitened residual ([`inflation`]), at least 1.
     pub phi: f64,
+    /// Least variance scale of the whitened residual the intervals take
+    /// (1 on a short record: the white level its samples measure; 0
+    /// otherwise).
+    pub min_scale: f64,
     /// Whitened columns of the terms without a non-linear parameter.
     fixed: HashMap<String, Whitened>,
 }
@@ -76,6 +80,7 @@ impl<'a> Design<'a> {
             y,
             steps,
             phi: 1.0,
+            min_scale: 0.0,
             fixed: HashMap::new(),
         };
         let mut kinds = vec![Kind::Constant];

@@ -15,7 +15,7 @@ use super::select::{columns, params_of};
 use super::terms::{Kind, Term};
 use crate::model::effects::Effect;
 use crate::numerics::lsq::wls;
-use crate::numerics::search::CHI2_1_95;
+use crate::numerics::stats::t_975;
 
 /// An effect's parameters with 95 % intervals: (name, value, lo, hi).
 #[derive(Clone, Debug)]
@@ -45,7 +45,11 @@ pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
     let n = d.n();
     let p: usize = terms.iter().map(|t| t.kind.dof()).sum();
     let phi = d.phi.max(inflation(&f.resid, &d.wh.keep));
-    let scale = f.sse / (n - p as f64).max(1.0) * phi;
+    // Residual degrees of freedom: Student's t for the variance the
+    // residual measures (none left: no interval at all).
+    let dof = n - p as f64;
+    let scale = (f.sse / dof.max(1.0) * phi).max(d.min_scale);
+    let q = t_975(dof);
     let cov = jacobian_cov(d, terms, &f.coef);
     let parts = d.parts(terms, &f.coef);
     let w = &d.win.count;
@@ -84,21 +88,22 @@ pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
                 let se = cov
                     .as_ref()
                     .map_or(f64::NAN, |c| (c.0[(col + i, col + i)] * scale).sqrt());
-                params.push((*name, *v, v - 1.96 * se, v + 1.96 * se));
+                params.push((*name, *v, v - q * se, v + q * se));
             } else {
-                let (lo, hi) = profile(d, terms, j, f.sse, scale);
+                let (lo, hi) = profile(d, terms, j, f.sse, q * q * scale);
                 // The Gauss-Newton interval, in the search's variable.
                 let wald = cov.as_ref().and_then(|c| {
                     let k = c.1.iter().position(|&x| x == j)?;
                     let se = (c.0[(c.2 + k, c.2 + k)] * scale).sqrt();
                     let log = t.kind.effect().is_some_and(|e| e.search_log());
                     Some(if log {
-                        ((v.ln() - 1.96 * se).exp(), (v.ln() + 1.96 * se).exp())
+                        ((v.ln() - q * se).exp(), (v.ln() + q * se).exp())
                     } else {
-                        (v - 1.96 * se, v + 1.96 * se)
+                        (v - q * se, v + q * se)
                     })
                 });
                 let (lo, hi) = match wald {
+                    _ if q.is_nan() => (f64::NAN, f64::NAN),
                     Some((a, b)) if a.is_finite() && b.is_finite() => (lo.min(a), hi.max(b)),
                     _ => (lo, hi),
                 };
@@ -131,6 +136,25 @@ pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
         parts,
         scale,
     })
+}
+
+/// Widens `fin`'s intervals to hold, about its own values, those of
+/// `other` (the same terms fitted under another noise model: one whose
+/// slow noise the record cannot exclude) about its values: each side the
+/// larger distance.
+pub fn widen(fin: &mut Final, other: &Final) {
+    for (a, b) in fin.estimates.iter_mut().zip(&other.estimates) {
+        let (Some(a), Some(b)) = (a, b) else {
+            continue;
+        };
+        for (p, q) in a.params.iter_mut().zip(&b.params) {
+            let (below, above) = (q.1 - q.2, q.3 - q.1);
+            if below.is_finite() && above.is_finite() {
+                p.2 = p.2.min(p.1 - below);
+                p.3 = p.3.max(p.1 + above);
+            }
+        }
+    }
 }
 
 /// The unscaled covariance of every linear coefficient (first, in the
@@ -187,8 +211,9 @@ fn jacobian_cov(
 /// scanned each way from the estimate until the whitened sum of squares
 /// rises by chi-square(1, 95 %) times the variance scale, the crossing
 /// interpolated in the square root of the rise (linear for a quadratic
-/// profile); the step halved until the first one stays under it.
-fn profile(d: &Design, terms: &[Term], j: usize, sse: f64, scale: f64) -> (f64, f64) {
+/// profile); the step halved until the first one stays under it. `thr` is
+/// that rise: the squared t quantile times the variance scale.
+fn profile(d: &Design, terms: &[Term], j: usize, sse: f64, thr: f64) -> (f64, f64) {
     let Kind::Effect(e) = terms[j].kind else {
         return (f64::NAN, f64::NAN);
     };
@@ -199,7 +224,6 @@ fn profile(d: &Design, terms: &[Term], j: usize, sse: f64, scale: f64) -> (f64, 
         ts[j].x = if log { u.exp() } else { u };
         d.sse(&ts) - sse
     };
-    let thr = CHI2_1_95 * scale;
     let (u0, bound) = if log { (x.ln(), 5.0) } else { (x, 30.0) };
     let side = |dir: f64| -> f64 {
         let mut step = if log { 0.02 } else { 0.1 };

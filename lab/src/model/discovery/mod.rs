@@ -41,7 +41,7 @@ use constant::Role;
 use design::{inflation, Design};
 use estimates::{estimate, Estimate};
 use noise_floor::{allan_of, disagreements, gap, noise_floor, Disagreement};
-use noise_model::{NoiseModel, Whitener};
+use noise_model::{NoiseModel, Whitener, MIN_COLOUR_WINDOWS};
 use select::{select, Ambiguous, Implausible, Selection};
 use std::collections::BTreeMap;
 use terms::{rotating, Kind, Term};
@@ -100,6 +100,9 @@ pub struct Discovery {
     /// Set when the joint fit's parameters would have widened the gap and
     /// the model written was re-fitted without the unexplained terms.
     pub fallback: Option<String>,
+    /// Set on a record too short for its intervals (fewer than
+    /// [`MIN_COLOUR_WINDOWS`] windows): why they are not to be relied on.
+    pub short: Option<String>,
     pub disagreements: Vec<Disagreement>,
     pub model_after: Model,
     pub allan_before: Option<Allan>,
@@ -167,10 +170,15 @@ fn left(d: &Design, terms: &[Term]) -> Vec<f64> {
         .collect()
 }
 
-/// The passes: white noise first, then the noise of what each leaves.
+/// The passes: white noise first, then the noise of what each leaves. On
+/// a short record (fewer than [`MIN_COLOUR_WINDOWS`] windows) the window
+/// means cannot show their noise: one pass, with the white noise the
+/// samples' own scatter measures, and that level the least variance the
+/// intervals take.
 fn passes<'a>(
     inp: &'a Inputs,
     win: &'a Windows,
+    r: &[f64],
     rw: &[f64],
     cands: &[Effect],
 ) -> (Design<'a>, Selection, NoiseModel, Transients, usize) {
@@ -178,6 +186,20 @@ fn passes<'a>(
     let x = extent(inp);
     let all = vec![true; n];
     let white = NoiseModel::white_of(rw, &all);
+    if n < MIN_COLOUR_WINDOWS {
+        let noise = NoiseModel::white_of_samples(r, win).unwrap_or(white);
+        let mut d = Design::new(
+            inp,
+            win,
+            x,
+            rw.to_vec(),
+            Whitener::new(&noise, win, &all),
+            vec![],
+        );
+        d.min_scale = 1.0;
+        let sel = select(&d, cands);
+        return (d, sel, noise, Transients::default(), 1);
+    }
     let d1 = Design::new(
         inp,
         win,
@@ -232,6 +254,49 @@ fn passes<'a>(
         names = now;
         prev = sel.terms();
         noise = ml(&d, &sel, &noise);
+    }
+}
+
+/// What a short record's intervals rest on, said plainly (None for a
+/// record long enough to measure its noise's colour).
+fn short_record(d: &Design, sel: &Selection) -> Option<String> {
+    let n = d.win.len();
+    if n >= MIN_COLOUR_WINDOWS {
+        return None;
+    }
+    let p: usize = sel.terms().iter().map(|t| t.kind.dof()).sum();
+    let dof = n.saturating_sub(p);
+    Some(format!(
+        "the record has {n} windows of {WINDOW_S} s, fewer than the {MIN_COLOUR_WINDOWS} its noise's colour is measured from: the intervals are unreliable (they assume white noise, at least the level its samples' scatter shows, with Student's t on {dof} degree{} of freedom, and cannot see slower noise); record longer for intervals to rely on",
+        if dof == 1 { "" } else { "s" }
+    ))
+}
+
+/// The intervals widened for the slow noise the record cannot exclude:
+/// the flicker and the random walk the restricted likelihood still allows
+/// at 95 % (noise_model.rs's `slow_bounds`), each in turn, the final terms
+/// refitted on the problem whitened by it. A slow level fitted as nothing
+/// (white noise hides a bias instability at every averaging time the Allan
+/// curve measures well) otherwise leaves a slow regressor's interval
+/// that of white noise.
+fn allow_slow_noise(d: &Design, terms: &[Term], noise: &NoiseModel, fin: &mut estimates::Final) {
+    let (cols, y) = d.raw_problem(terms);
+    for up in noise_model::slow_bounds(noise, d.win, &d.wh.keep, &y, &cols) {
+        if up == *noise {
+            continue;
+        }
+        let mut du = Design::new(
+            d.inp,
+            d.win,
+            d.extent,
+            d.r.clone(),
+            Whitener::new(&up, d.win, &d.wh.keep),
+            d.steps.clone(),
+        );
+        du.phi = d.phi;
+        if let Some(f) = estimate(&du, terms) {
+            estimates::widen(fin, &f);
+        }
     }
 }
 
@@ -305,10 +370,16 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     let floor = noise_floor(&win, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
     let (cands, skipped) = candidates(model.gyro, inp);
-    let (d, sel, noise, tr, passes) = passes(inp, &win, &rw, &cands);
+    let (d, sel, noise, tr, passes) = passes(inp, &win, &r, &rw, &cands);
+    let short = short_record(&d, &sel);
     let (role, amb_const, _) = constant::role(&d, &sel, &cands);
     let terms = sel.terms();
-    let fin = estimate(&d, &terms);
+    let mut fin = estimate(&d, &terms);
+    if short.is_none() {
+        if let Some(f) = fin.as_mut() {
+            allow_slow_noise(&d, &terms, &noise, f);
+        }
+    }
     let est = |j: usize| -> Option<Estimate> {
         fin.as_ref()
             .and_then(|f| f.estimates.get(j).cloned().flatten())
@@ -421,6 +492,7 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
         noise,
         passes,
         fallback,
+        short,
         disagreements,
         residual_before: r,
         residual_after: r_after,

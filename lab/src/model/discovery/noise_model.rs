@@ -41,6 +41,11 @@ const FLICKER_SPACING: f64 = 3.162_277_660_168_379_5;
 /// Shortest flicker correlation time, s (faster ones are white in a 1 s mean).
 const FLICKER_MIN_S: f64 = 2.0;
 
+/// Fewest windows whose scatter the noise's colour is measured from (the
+/// Allan fit of [`NoiseModel::from_residual`] and the likelihood of
+/// [`refine`]); a shorter record is a short one (docs/discovery.md).
+pub const MIN_COLOUR_WINDOWS: usize = 64;
+
 /// The noise of the residual's window means.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct NoiseModel {
@@ -81,6 +86,43 @@ impl NoiseModel {
         }
     }
 
+    /// White noise from the scatter of the residual's own samples within
+    /// each window (neighbours' differences, so no slow shape enters),
+    /// as the variance of a full window's mean: on a record too short for
+    /// its window means to show their noise, the one level the samples
+    /// still measure. The mean square difference, its largest 1 % left out
+    /// (a table's rate step), over the share of a Gaussian's chi-square(1)
+    /// mean below its 99 % quantile (P(chi2_3 < 6.635) / 0.99).
+    pub fn white_of_samples(r: &[f64], win: &Windows) -> Option<Self> {
+        let mut d2: Vec<f64> = (1..r.len().min(win.idx.len()))
+            .filter(|&k| win.idx[k] == win.idx[k - 1])
+            .map(|k| (r[k] - r[k - 1]).powi(2))
+            .filter(|v| v.is_finite())
+            .collect();
+        if d2.len() < 10 {
+            return None;
+        }
+        d2.sort_by(f64::total_cmp);
+        let kept = &d2[..(d2.len() as f64 * 0.99).ceil() as usize];
+        let ms = kept.iter().sum::<f64>() / kept.len() as f64;
+        let var = ms / (2.0 * 0.915_508 / 0.99);
+        let mut counts = win.count.clone();
+        counts.sort_by(f64::total_cmp);
+        let nominal = counts
+            .get(counts.len() / 2)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1.0);
+        let white = var / nominal;
+        (white > 0.0).then_some(Self {
+            white,
+            flicker: 0.0,
+            random_walk: 0.0,
+            markov: 0.0,
+            markov_s: 1.0,
+        })
+    }
+
     /// From the Allan variance of a residual's window means `means` (the
     /// windows `keep` says; spikes left out), `tau0` s apart: the IEEE 952
     /// terms fitted by [`fit_terms`] to the curve up to a tenth of the
@@ -96,7 +138,7 @@ impl NoiseModel {
             .map(|(v, _)| *v)
             .collect();
         let white = Self::white_of(means, keep);
-        if m.len() < 64 {
+        if m.len() < MIN_COLOUR_WINDOWS {
             return white;
         }
         // Averaging times up to a fifth of the record: beyond, the few
@@ -228,10 +270,98 @@ pub fn fit_terms(
     best
 }
 
+/// The restricted log-likelihood of noise model `m` for the residual
+/// less fixed parts `y` and a fit's raw columns `cols` (window means), the
+/// white level profiled out as the common scale.
+fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64>]) -> f64 {
+    let w = Whitener::new(m, win, keep);
+    let yw = w.whiten(y);
+    let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
+    let sse = match super::normal::normal_solve(&cw, &yw) {
+        Some(b) if !cw.is_empty() => {
+            let mut r = yw.clone();
+            for (c, bj) in cw.iter().zip(&b) {
+                for (a, v) in r.iter_mut().zip(c) {
+                    *a -= bj * v;
+                }
+            }
+            r.iter().map(|v| v * v).sum::<f64>()
+        }
+        _ => yw.iter().map(|v| v * v).sum::<f64>(),
+    };
+    // The restricted likelihood (REML): the fit's p columns take p
+    // degrees of freedom of the residual, and their Gram determinant
+    // weighs how much of each slow noise level they can absorb. Plain
+    // maximum likelihood (n in place of n - p, no determinant) reads the
+    // slow noise the fitted shapes soaked up as absent, and the slow
+    // levels, and with them the intervals, came out too small.
+    let n = w.used() as f64;
+    let p = cw.len() as f64;
+    let gram = if cw.is_empty() {
+        Some(0.0)
+    } else {
+        gram_log_det(&cw)
+    };
+    let Some(gram) = gram else {
+        return f64::NEG_INFINITY;
+    };
+    let m = (n - p).max(1.0);
+    -0.5 * (m * (sse / m).max(1e-300).ln() + w.log_det() + gram)
+}
+
+/// Half the chi-square(1) 95 % quantile: the fall of the log-likelihood
+/// at a level's 95 % profile bound.
+const HALF_CHI2_1_95: f64 = 1.920_729_410_347_062;
+
+/// The noise model with, in turn, its flicker and its random walk raised
+/// to the largest level the record cannot exclude (restricted likelihood
+/// within [`HALF_CHI2_1_95`] of `m`'s, the level scanned up in eighths of
+/// a decade from `m`'s, or a ten-thousandth of the white level, to a
+/// thousand times that): the slow noise a fit's intervals must allow for
+/// when the Allan curve and the likelihood cannot tell it from none.
+pub fn slow_bounds(
+    m: &NoiseModel,
+    win: &Windows,
+    keep: &[bool],
+    y: &[f64],
+    cols: &[Vec<f64>],
+) -> Vec<NoiseModel> {
+    let l0 = reml(m, win, keep, y, cols);
+    let floor = m.white * 1e-4;
+    (0..2)
+        .map(|which| {
+            let base = if which == 0 {
+                m.flicker.max(floor)
+            } else {
+                m.random_walk.max(floor * 1e-3)
+            };
+            let mut best = l0;
+            let mut up = *m;
+            for k in 1..=24 {
+                let mut c = *m;
+                let v = base * 10f64.powf(0.125 * k as f64);
+                if which == 0 {
+                    c.flicker = v;
+                } else {
+                    c.random_walk = v;
+                }
+                let l = reml(&c, win, keep, y, cols);
+                best = best.max(l);
+                if l < best - HALF_CHI2_1_95 {
+                    break;
+                }
+                up = c;
+            }
+            up
+        })
+        .collect()
+}
+
 /// The noise model, given the terms of a fit (their raw columns `cols`
 /// and the residual less their fixed parts `y`, window means), with its
-/// random walk, flicker and Markov levels refined by maximum likelihood
-/// (each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
+/// random walk, flicker and Markov levels refined by restricted maximum
+/// likelihood (REML: the likelihood of the residual's contrasts the fit's
+/// columns leave; each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
 /// twice; the white level profiled out as the common scale).
 pub fn refine(
     start: &NoiseModel,
@@ -240,25 +370,7 @@ pub fn refine(
     y: &[f64],
     cols: &[Vec<f64>],
 ) -> NoiseModel {
-    let loglik = |m: &NoiseModel| -> f64 {
-        let w = Whitener::new(m, win, keep);
-        let yw = w.whiten(y);
-        let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
-        let sse = match super::normal::normal_solve(&cw, &yw) {
-            Some(b) if !cw.is_empty() => {
-                let mut r = yw.clone();
-                for (c, bj) in cw.iter().zip(&b) {
-                    for (a, v) in r.iter_mut().zip(c) {
-                        *a -= bj * v;
-                    }
-                }
-                r.iter().map(|v| v * v).sum::<f64>()
-            }
-            _ => yw.iter().map(|v| v * v).sum::<f64>(),
-        };
-        let n = w.used() as f64;
-        -0.5 * (n * (sse / n).max(1e-300).ln() + w.log_det())
-    };
+    let loglik = |m: &NoiseModel| reml(m, win, keep, y, cols);
     let mut m = *start;
     let floor = m.white * 1e-4;
     let mut best = loglik(&m);
@@ -288,6 +400,22 @@ pub fn refine(
         }
     }
     m
+}
+
+/// ln det of the Gram matrix of `cols` (None when it is singular).
+fn gram_log_det(cols: &[Vec<f64>]) -> Option<f64> {
+    let m = cols.len();
+    let g = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        cols[i]
+            .iter()
+            .zip(&cols[j])
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+    });
+    let c = g.cholesky()?;
+    let l = c.l_dirty();
+    let s: f64 = (0..m).map(|i| 2.0 * l[(i, i)].ln()).sum();
+    s.is_finite().then_some(s)
 }
 
 /// The Kalman filter's gains for a noise model over a run's windows: it

@@ -29,6 +29,9 @@ use crate::model::ranges;
 /// Criterion decrease a term must bring to come in, and to stay ("very
 /// strong" evidence).
 pub const THRESHOLD: f64 = 10.0;
+/// Windows a fit must leave beyond its parameters (its residual's degrees
+/// of freedom).
+pub const MIN_RESIDUAL_DOF: f64 = 1.0;
 /// Ambiguity: criteria within this much of the best's ...
 pub const AMBIGUITY_MARGIN: f64 = 10.0;
 /// ... and explained parts correlated this much.
@@ -209,12 +212,17 @@ fn trials(d: &Design, open: &[Term], base: &[Term], r_cur: &[f64], c_cur: f64) -
     for cand in open {
         let mut terms = base.to_vec();
         terms.push(*cand);
+        let dof: usize = terms.iter().map(|t| t.kind.dof()).sum();
+        // A fit must leave the residual some scatter to measure its noise
+        // by: as many parameters as windows fit any record exactly.
+        if (dof as f64) + MIN_RESIDUAL_DOF > d.n() {
+            continue;
+        }
         let j = terms.len() - 1;
         d.optimize(&mut terms, j);
         let Some(f) = d.fit(&terms) else {
             continue;
         };
-        let dof: usize = terms.iter().map(|t| t.kind.dof()).sum();
         out.push(Trial {
             term: terms[j],
             delta: d.criterion(f.sse, dof) - c_cur,
