@@ -99,7 +99,9 @@ pub static FOG_SF_RECORD: [u8; FOG_SF_RECORD_LEN] =
 pub struct FramePath {
     frames: FrameBuilder,
     tx: Producer<'static, Frame, FRAME_QUEUE_LEN>,
-    sf_cfg: ScaleFactorConfig,
+    /// In its own static: a 64-node table (about 1.8 kB) is not moved
+    /// through the start-up stack with the rest of the frame path.
+    sf_cfg: &'static ScaleFactorConfig,
     sf: ScaleFactorComp,
     /// Closure periods since start, missed ones included: the frames' time base.
     closures: u32,
@@ -112,7 +114,7 @@ impl FramePath {
     pub fn new(
         frames: FrameBuilder,
         tx: Producer<'static, Frame, FRAME_QUEUE_LEN>,
-        sf_cfg: ScaleFactorConfig,
+        sf_cfg: &'static ScaleFactorConfig,
         reset_cause: ResetCause,
     ) -> Self {
         let mut frames = frames;
@@ -149,7 +151,7 @@ impl FramePath {
     /// A coil temperature reading (Q8 degC; None: the read failed) advances
     /// the table's state.
     pub fn coil_reading(&mut self, read: Option<i32>) {
-        self.sf.update_temperature(&self.sf_cfg, read);
+        self.sf.update_temperature(self.sf_cfg, read);
     }
 
     /// Adds one closure's output; returns the frame it completes, not yet
@@ -161,7 +163,7 @@ impl FramePath {
 
     /// Applies the scale-factor table at the coil temperature to a frame.
     pub fn compensate(&self, f: &mut Frame) {
-        f.compensate_fog(&self.sf, &self.sf_cfg);
+        f.compensate_fog(&self.sf, self.sf_cfg);
     }
 
     /// Queues a frame for the main loop with its angle words made

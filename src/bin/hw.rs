@@ -216,7 +216,12 @@ mod app {
         }
         let mut fog = FogLoop::new(&cfg);
         let coil_dt_s = (SENSOR_EVERY * COIL_EVERY) as f64 / RLG_HZ as f64;
-        let sf_cfg = ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, coil_dt_s);
+        // Built in its static, not moved through the start-up stack.
+        let Some(sf_cfg) = cortex_m::singleton!(: ScaleFactorConfig =
+            ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, coil_dt_s))
+        else {
+            reset()
+        };
         if sf_cfg.coeffs_refused {
             defmt::warn!(
                 "FOG scale-factor record refused: running without temperature compensation"

@@ -373,7 +373,12 @@ mod app {
             sensor: Tmp117::new(COIL_SENSOR),
             bus: SimI2c::new(),
         };
-        let sf_cfg = ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, sensor_dt_s);
+        // Built in its static, as the rig is, not moved through the stack.
+        let Some(sf_cfg) = cortex_m::singleton!(: ScaleFactorConfig =
+            ScaleFactorConfig::from_record(&FOG_SF_RECORD, &cfg, sensor_dt_s))
+        else {
+            fail()
+        };
         if sf_cfg.coeffs_refused {
             defmt::warn!(
                 "FOG scale-factor record refused: running without temperature compensation"
