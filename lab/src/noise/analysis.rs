@@ -136,28 +136,3 @@ impl std::fmt::Display for SamplingError {
         }
     }
 }
-
-/// The sample period of `t` (the median interval), checked: every interval
-/// within [`SAMPLING_TOLERANCE`] of it.
-pub fn sample_period(t: &[f64]) -> Result<f64, SamplingError> {
-    if t.len() < 2 {
-        return Ok(1.0);
-    }
-    let d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let mut sorted = d.clone();
-    sorted.sort_by(f64::total_cmp);
-    let med = sorted[sorted.len() / 2];
-    if med.is_nan() || med <= 0.0 {
-        return Err(SamplingError::NotIncreasing);
-    }
-    for (k, h) in d.iter().enumerate() {
-        if (*h - med).abs() > SAMPLING_TOLERANCE * med {
-            return Err(SamplingError::Uneven {
-                row: k + 1,
-                interval: *h,
-                median: med,
-            });
-        }
-    }
-    Ok(med)
-}
