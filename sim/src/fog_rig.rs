@@ -64,6 +64,11 @@ where
         }
     }
 
+    /// The DAC words the next closure applies (one per half period).
+    pub fn applied_dac(&self) -> &[u16] {
+        &self.dac[0][..self.cfg.n_half]
+    }
+
     pub fn closure_index(&self) -> u64 {
         self.closure_index
     }
