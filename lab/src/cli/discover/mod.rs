@@ -142,6 +142,11 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "carried": carried,
         "implausible": implausible,
         "dropped": d.dropped,
+        "not_confirmed": d
+            .not_confirmed
+            .iter()
+            .map(|(e, g)| serde_json::json!({"effect": e, "gain": g}))
+            .collect::<Vec<_>>(),
         "skipped": skipped,
         "disagreements": d.disagreements,
         "noise": {

@@ -341,6 +341,9 @@ fn backward(d: &Design, st: &mut State) {
             .min_by(|a, b| a.2.total_cmp(&b.2));
         match cheapest {
             Some((list, t, cost)) if cost < THRESHOLD => {
+                if std::env::var("DISC_TRACE").is_ok() {
+                    eprintln!("TRACE drop {:?} cost {:.1}", t, cost);
+                }
                 st.remove(list, &t);
                 refit(d, &mut st.sel);
             }
@@ -425,6 +428,90 @@ fn open(d: &Design, candidates: &[Effect], st: &State) -> Vec<Term> {
     v
 }
 
+/// Exchanges a selection may make.
+pub const MAX_EXCHANGES: usize = 4;
+
+/// Exchanges tried in full per exchange step (the best of the quick
+/// trials).
+const EXCHANGE_TRIES: usize = 6;
+
+/// The criterion of `terms` once every non-linear parameter is re-fitted
+/// and every term (the constant aside) whose removal costs less than
+/// [`THRESHOLD`] is dropped, cheapest first.
+fn settled(d: &Design, mut terms: Vec<Term>) -> f64 {
+    for j in 0..terms.len() {
+        d.optimize(&mut terms, j);
+    }
+    loop {
+        let c = d.criterion_of(&terms);
+        let cheapest = (1..terms.len())
+            .map(|j| {
+                let rest: Vec<Term> = terms
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| *i != j)
+                    .map(|(_, t)| *t)
+                    .collect();
+                (j, d.criterion_of(&rest) - c)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match cheapest {
+            Some((j, cost)) if cost < THRESHOLD => {
+                terms.remove(j);
+            }
+            _ => return c,
+        }
+    }
+}
+
+/// The exchange step (sequential replacement), once nothing more comes in:
+/// each term in (named or unexplained) is tried replaced by each open
+/// candidate, the latter's non-linear parameter searched; the best few
+/// replacements are then settled (every non-linear parameter re-fitted,
+/// what the replacement makes redundant dropped). When one lowers the
+/// criterion by more than [`THRESHOLD`], the term it replaces and the
+/// kind that replaces it: the term leaves (it may come back), and the
+/// replacement comes in through the forward step's checks. A forward
+/// selection that took first what explains most of two effects together
+/// (a monoblock difference's square for a case temperature with a
+/// warm-up) otherwise keeps it, and the effects it imitates never come in.
+fn exchange(d: &Design, candidates: &[Effect], st: &State) -> Option<(usize, Term, Term)> {
+    let base = st.sel.terms();
+    let c_cur = d.criterion_of(&base);
+    let open = open(d, candidates, st);
+    let mut quick: Vec<(usize, Term, Term, f64)> = vec![];
+    for (list, t) in st.removable() {
+        if list == 1 {
+            continue;
+        }
+        let rest: Vec<Term> = base.iter().filter(|x| **x != t).copied().collect();
+        let Some(cur) = d.fit(&rest) else {
+            continue;
+        };
+        let c_rest = d.criterion_of(&rest);
+        for tr in trials(d, &open, &rest, &cur.resid, c_rest) {
+            if tr.term.kind != t.kind {
+                quick.push((list, t, tr.term, c_rest + tr.delta - c_cur));
+            }
+        }
+    }
+    quick.sort_by(|a, b| a.3.total_cmp(&b.3));
+    let mut best: Option<(usize, Term, Term, f64)> = None;
+    for (list, t, cand, _) in quick.into_iter().take(EXCHANGE_TRIES) {
+        let mut terms: Vec<Term> = base.iter().filter(|x| **x != t).copied().collect();
+        terms.push(cand);
+        let delta = settled(d, terms) - c_cur;
+        if best.as_ref().is_none_or(|b| delta < b.3) {
+            best = Some((list, t, cand, delta));
+        }
+    }
+    let (list, t, cand, delta) = best?;
+    if std::env::var("DISC_TRACE").is_ok() {
+        eprintln!("TRACE exchange {:?} -> {:?} delta {:.1}", t, cand, delta);
+    }
+    (delta < -THRESHOLD).then_some((list, t, cand))
+}
+
 /// Stepwise selection over `candidates` (library effects; not the bias,
 /// whose constant every fit carries).
 pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
@@ -440,18 +527,40 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
         closed: vec![],
         closed_steps: vec![],
     };
+    let mut exchanges = 0;
+    let mut next_forced: Option<Term> = None;
     for _ in 0..4 * (candidates.len() + Shape::ALL.len() + d.steps.len() + 2) {
+        let forced = next_forced.take();
         let base = st.sel.terms();
         let Some(cur) = d.fit(&base) else {
             break;
         };
         let c_cur = d.criterion_of(&base);
         let ts = trials(d, &open(d, candidates, &st), &base, &cur.resid, c_cur);
-        let Some(mut best) = (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta))
-        else {
+        let forced = forced.and_then(|k: Term| {
+                ts.iter().position(|t| {
+                    t.term.kind == k.kind && (k.kind != Kind::Step || t.term.x == k.x)
+                })
+            });
+        let Some(mut best) = forced.or_else(|| {
+            (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta))
+        }) else {
             break;
         };
-        if ts[best].delta > -THRESHOLD {
+        if forced.is_none() && ts[best].delta > -THRESHOLD {
+            if exchanges < MAX_EXCHANGES {
+                if let Some((list, t, cand)) = exchange(d, candidates, &st) {
+                    exchanges += 1;
+                    let s = &mut st.sel;
+                    match list {
+                        0 => s.named.retain(|x| x.term != t),
+                        _ => s.nuisance.retain(|x| *x != t),
+                    }
+                    refit(d, s);
+                    next_forced = Some(cand);
+                    continue;
+                }
+            }
             break;
         }
         // A shape yields to an effect that explains the same as well.
@@ -468,6 +577,9 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
             match rival {
                 Some(i) => best = i,
                 None => {
+                    if std::env::var("DISC_TRACE").is_ok() {
+                        eprintln!("TRACE nuisance {:?} delta {:.1}", ts[best].term, ts[best].delta);
+                    }
                     st.sel.nuisance.push(ts[best].term);
                     refit(d, &mut st.sel);
                     backward(d, &mut st);
@@ -476,6 +588,11 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
             }
         }
         let b = &ts[best];
+        if std::env::var("DISC_TRACE").is_ok() {
+            let mut v: Vec<_> = ts.iter().map(|t| (t.delta, t.term.kind.describe(), t.term.x)).collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            eprintln!("TRACE add {:?} delta {:.1}; top {:?}", b.term, b.delta, &v[..v.len().min(5)]);
+        }
         let Some(e) = b.term.kind.effect() else {
             break;
         };
