@@ -312,6 +312,14 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
             g.suggestion
         );
     }
+    for (e, g) in &d.not_confirmed {
+        println!(
+            "not named {}: it paid on the selection's noise, but once the noise (random walk, flicker, Markov) is re-fitted without it, it gains only {:.1} (threshold {}): the noise imitates it",
+            e.name(),
+            g,
+            crate::model::discovery::select::THRESHOLD
+        );
+    }
     for i in &d.implausible {
         let o: Vec<String> = i
             .outside

@@ -19,7 +19,7 @@
 //! selection run again without it.
 
 use super::design::Design;
-use super::noise_model::{loglik, profile, NoiseModel};
+use super::noise_model::{profile, NoiseModel};
 use super::select::{Selection, THRESHOLD};
 use super::terms::{Kind, Term};
 use crate::model::effects::Effect;
@@ -27,13 +27,13 @@ use crate::model::effects::Effect;
 /// Effects set aside at most (then the selection stands as it is).
 pub const MAX_SET_ASIDE: usize = 3;
 
-/// What `terms[j]` gains the fit of `terms` on the noise fitted without
-/// it (its random walk, flicker and Markov levels re-fitted by maximum
-/// likelihood from `noise`): twice the log-likelihood ratio on that noise,
-/// less its BIC penalty (the criterion's decrease, as the selection's
-/// delta with the sign turned). The noise is the one the record shows
-/// without the effect, as a score test takes the null's nuisance
-/// parameters: the effect must pay against what the noise alone explains.
+/// What `terms[j]` gains the fit of `terms` once the noise is re-fitted
+/// on each side (its random walk, flicker and Markov levels by maximum
+/// likelihood, from `noise`): twice the log-likelihood ratio less its BIC
+/// penalty (the criterion's decrease, as the selection's delta with the
+/// sign turned). The side without the effect may raise its slow noise to
+/// imitate it, but pays for a level the rest of the record does not show:
+/// a decaying warm-up is not a random walk that happened to fall.
 pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel) -> f64 {
     let rest: Vec<Term> = terms
         .iter()
@@ -44,7 +44,7 @@ pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel) -> f64 {
     let (cols, y) = d.raw_problem(&rest);
     let (m0, l0) = profile(noise, d.win, &d.wh.keep, &y, &cols, false);
     let (cols, y) = d.raw_problem(terms);
-    let l1 = loglik(&m0, d.win, &d.wh.keep, &y, &cols, false);
+    let (_, l1) = profile(noise, d.win, &d.wh.keep, &y, &cols, false);
     let g = 2.0 * (l1 - l0) - terms[j].kind.dof() as f64 * d.n().max(2.0).ln();
     if std::env::var("DISC_TRACE").is_ok() {
         eprintln!("TRACE confirm {:?}: gain {g:.1} noise without {m0:?}", terms[j].kind);

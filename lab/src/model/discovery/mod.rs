@@ -356,7 +356,13 @@ fn plain_refit(d: &Design, written: &[(Term, Estimate)]) -> Vec<Estimate> {
                 {
                     continue;
                 }
-                p.1 = coef.get(col).copied().unwrap_or(p.1);
+                // The value re-fitted; its interval keeps the joint fit's
+                // width (which allows for the unexplained terms), about it.
+                let v = coef.get(col).copied().unwrap_or(p.1);
+                let shift = v - p.1;
+                p.1 = v;
+                p.2 += shift;
+                p.3 += shift;
                 col += 1;
             }
             e

@@ -280,7 +280,7 @@ fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64
 /// The log-likelihood of noise model `m` for `y` less the fit of `cols`:
 /// restricted ([`reml`]) or plain maximum likelihood (n in place of n - p,
 /// no Gram determinant: the one that compares fits of different columns).
-pub fn loglik(
+fn loglik(
     m: &NoiseModel,
     win: &Windows,
     keep: &[bool],
