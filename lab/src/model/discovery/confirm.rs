@@ -34,22 +34,22 @@ pub const MAX_SET_ASIDE: usize = 3;
 /// sign turned). The side without the effect may raise its slow noise to
 /// imitate it, but pays for a level the rest of the record does not show:
 /// a decaying warm-up is not a random walk that happened to fall.
-pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel) -> f64 {
+/// `full` is [`loglik`] of `terms`.
+pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel, full: f64) -> f64 {
     let rest: Vec<Term> = terms
         .iter()
         .enumerate()
         .filter(|(i, _)| *i != j)
         .map(|(_, t)| *t)
         .collect();
-    let (cols, y) = d.raw_problem(&rest);
-    let (m0, l0) = profile(noise, d.win, &d.wh.keep, &y, &cols, false);
+    2.0 * (full - loglik(d, &rest, noise)) - terms[j].kind.dof() as f64 * d.n().max(2.0).ln()
+}
+
+/// The fit of `terms`' log-likelihood, its noise's slow levels re-fitted
+/// by maximum likelihood from `noise`.
+pub fn loglik(d: &Design, terms: &[Term], noise: &NoiseModel) -> f64 {
     let (cols, y) = d.raw_problem(terms);
-    let (_, l1) = profile(noise, d.win, &d.wh.keep, &y, &cols, false);
-    let g = 2.0 * (l1 - l0) - terms[j].kind.dof() as f64 * d.n().max(2.0).ln();
-    if std::env::var("DISC_TRACE").is_ok() {
-        eprintln!("TRACE confirm {:?}: gain {g:.1} noise without {m0:?}", terms[j].kind);
-    }
-    g
+    profile(noise, d.win, &d.wh.keep, &y, &cols, false).1
 }
 
 /// The named effect the fit needs least once the noise is re-fitted
@@ -59,11 +59,12 @@ pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Effec
         return None;
     }
     let terms = sel.terms();
+    let full = loglik(d, &terms, noise);
     terms
         .iter()
         .enumerate()
         .filter(|(_, t)| sel.named.iter().any(|s| s.term == **t))
-        .filter_map(|(j, t)| Some((t.kind.effect()?, gain(d, &terms, j, noise))))
+        .filter_map(|(j, t)| Some((t.kind.effect()?, gain(d, &terms, j, noise, full))))
         .filter(|(_, g)| *g < THRESHOLD)
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }
@@ -73,5 +74,5 @@ pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Effec
 pub fn constant_gain(d: &Design, sel: &Selection, noise: &NoiseModel) -> f64 {
     let terms = sel.terms();
     debug_assert_eq!(terms[0].kind, Kind::Constant);
-    gain(d, &terms, 0, noise)
+    gain(d, &terms, 0, noise, loglik(d, &terms, noise))
 }

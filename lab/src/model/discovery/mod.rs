@@ -399,22 +399,6 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
             None => break out,
         }
     };
-    if std::env::var("DISC_TRACE").is_ok() {
-        eprintln!("TRACE noise {:?} phi {:.2} passes {passes}", noise, d.phi);
-        let terms = sel.terms();
-        eprintln!("TRACE final {:?} crit {:.1}", terms, d.criterion_of(&terms));
-        if let Ok(alt) = std::env::var("DISC_ALT") {
-            let mut ts = vec![Term::of(Kind::Constant)];
-            for a in alt.split(',') {
-                if let Some(e) = Effect::from_name(a) {
-                    ts.push(Term::of(Kind::Effect(e)));
-                    let j = ts.len() - 1;
-                    d.optimize(&mut ts, j);
-                }
-            }
-            eprintln!("TRACE alt {:?} crit {:.1}", ts, d.criterion_of(&ts));
-        }
-    }
     let short = short_record(&d, &sel);
     let (mut role, amb_const, _) = constant::role(&d, &sel, &cands);
     if role == Role::Named && short.is_none() {

@@ -341,9 +341,6 @@ fn backward(d: &Design, st: &mut State) {
             .min_by(|a, b| a.2.total_cmp(&b.2));
         match cheapest {
             Some((list, t, cost)) if cost < THRESHOLD => {
-                if std::env::var("DISC_TRACE").is_ok() {
-                    eprintln!("TRACE drop {:?} cost {:.1}", t, cost);
-                }
                 st.remove(list, &t);
                 refit(d, &mut st.sel);
             }
@@ -506,9 +503,6 @@ fn exchange(d: &Design, candidates: &[Effect], st: &State) -> Option<(usize, Ter
         }
     }
     let (list, t, cand, delta) = best?;
-    if std::env::var("DISC_TRACE").is_ok() {
-        eprintln!("TRACE exchange {:?} -> {:?} delta {:.1}", t, cand, delta);
-    }
     (delta < -THRESHOLD).then_some((list, t, cand))
 }
 
@@ -577,9 +571,6 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
             match rival {
                 Some(i) => best = i,
                 None => {
-                    if std::env::var("DISC_TRACE").is_ok() {
-                        eprintln!("TRACE nuisance {:?} delta {:.1}", ts[best].term, ts[best].delta);
-                    }
                     st.sel.nuisance.push(ts[best].term);
                     refit(d, &mut st.sel);
                     backward(d, &mut st);
@@ -588,11 +579,6 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
             }
         }
         let b = &ts[best];
-        if std::env::var("DISC_TRACE").is_ok() {
-            let mut v: Vec<_> = ts.iter().map(|t| (t.delta, t.term.kind.describe(), t.term.x)).collect();
-            v.sort_by(|a, b| a.0.total_cmp(&b.0));
-            eprintln!("TRACE add {:?} delta {:.1}; top {:?}", b.term, b.delta, &v[..v.len().min(5)]);
-        }
         let Some(e) = b.term.kind.effect() else {
             break;
         };

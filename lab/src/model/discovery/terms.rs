@@ -215,3 +215,23 @@ impl Term {
         Self { kind, x: 0.0 }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curvature_is_exact_for_a_cubic_up_to_the_record_ends() {
+        // x = a t^3 + b t^2 over 1 h at 1 Hz: x'' = 6 a t + 2 b everywhere,
+        // the first and last rows included (the nested one-sided slopes
+        // there were off by up to half).
+        let (a, b) = (1e-10, 3e-6);
+        let t: Vec<f64> = (0..3600).map(|k| k as f64).collect();
+        let x: Vec<f64> = t.iter().map(|s| a * s * s * s + b * s * s).collect();
+        let c = curvature(&t, &x, CURVATURE_HALF_WIDTH_S);
+        for k in [0, 1, 60, 239, 240, 1800, 3360, 3500, 3599] {
+            let want = 6.0 * a * t[k] + 2.0 * b;
+            assert!((c[k] / want - 1.0).abs() < 1e-6, "{k}: {} vs {want}", c[k]);
+        }
+    }
+}
