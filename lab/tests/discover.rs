@@ -514,7 +514,10 @@ fn a_burst_that_swings_both_ways_is_unexplained_where_it_is() {
             assert!(!spans.is_empty(), "seed {seed}: {v}");
             for sp in spans {
                 let (a, b) = (sp["from_s"].as_f64().unwrap(), sp["to_s"].as_f64().unwrap());
-                assert!(a >= 1440.0 && b <= 1860.0, "seed {seed}: span {a}..{b}: {v}");
+                assert!(
+                    a >= 1440.0 && b <= 1860.0,
+                    "seed {seed}: span {a}..{b}: {v}"
+                );
             }
         }
     }

@@ -532,13 +532,12 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
         let c_cur = d.criterion_of(&base);
         let ts = trials(d, &open(d, candidates, &st), &base, &cur.resid, c_cur);
         let forced = forced.and_then(|k: Term| {
-                ts.iter().position(|t| {
-                    t.term.kind == k.kind && (k.kind != Kind::Step || t.term.x == k.x)
-                })
-            });
-        let Some(mut best) = forced.or_else(|| {
-            (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta))
-        }) else {
+            ts.iter()
+                .position(|t| t.term.kind == k.kind && (k.kind != Kind::Step || t.term.x == k.x))
+        });
+        let Some(mut best) =
+            forced.or_else(|| (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta)))
+        else {
             break;
         };
         if forced.is_none() && ts[best].delta > -THRESHOLD {

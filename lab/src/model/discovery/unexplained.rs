@@ -165,8 +165,7 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
                 .filter(|x| **x)
                 .count() as f64;
             let ss = c.iter().map(|v| v * v).sum::<f64>() / src.scale.max(1e-300);
-            used >= 0.5 * k
-                && ss > crate::numerics::stats::chi2_quantile(1.0 - tail, used)
+            used >= 0.5 * k && ss > crate::numerics::stats::chi2_quantile(1.0 - tail, used)
         })
         .map(|(b, c)| (b * BLOCK_WINDOWS, b * BLOCK_WINDOWS + c.len() - 1))
         .filter(|x| !flagged.contains(x))
