@@ -142,6 +142,11 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "carried": carried,
         "implausible": implausible,
         "dropped": d.dropped,
+        "not_confirmed": d
+            .not_confirmed
+            .iter()
+            .map(|(e, g)| serde_json::json!({"effect": e, "gain": g}))
+            .collect::<Vec<_>>(),
         "skipped": skipped,
         "disagreements": d.disagreements,
         "noise": {
@@ -305,6 +310,14 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
             g.correlation.get(1).copied().unwrap_or(1.0),
             g.carried_as.name(),
             g.suggestion
+        );
+    }
+    for (e, g) in &d.not_confirmed {
+        println!(
+            "not named {}: it paid on the selection's noise, but once the noise (random walk, flicker, Markov) is re-fitted without it, it gains only {:.1} (threshold {}): the noise imitates it",
+            e.name(),
+            g,
+            crate::model::discovery::select::THRESHOLD
         );
     }
     for i in &d.implausible {

@@ -18,6 +18,7 @@
 //! 4. The model with the named and carried effects added, checked never to
 //!    explain less than the one it started from.
 
+pub mod confirm;
 pub mod constant;
 pub mod design;
 pub mod estimates;
@@ -88,6 +89,10 @@ pub struct Discovery {
     pub unexplained: Option<Unexplained>,
     /// Effects the backward steps removed after they came in.
     pub dropped: Vec<String>,
+    /// Effects (and the constant, as `bias`) that paid on the selection's
+    /// noise but not once the noise was re-fitted without them
+    /// (confirm.rs), with what they gained then (below the threshold).
+    pub not_confirmed: Vec<(Effect, f64)>,
     pub skipped: Vec<Skipped>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
@@ -351,7 +356,13 @@ fn plain_refit(d: &Design, written: &[(Term, Estimate)]) -> Vec<Estimate> {
                 {
                     continue;
                 }
-                p.1 = coef.get(col).copied().unwrap_or(p.1);
+                // The value re-fitted; its interval keeps the joint fit's
+                // width (which allows for the unexplained terms), about it.
+                let v = coef.get(col).copied().unwrap_or(p.1);
+                let shift = v - p.1;
+                p.1 = v;
+                p.2 += shift;
+                p.3 += shift;
                 col += 1;
             }
             e
@@ -370,9 +381,34 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     let floor = noise_floor(&win, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
     let (cands, skipped) = candidates(model.gyro, inp);
-    let (d, sel, noise, tr, passes) = passes(inp, &win, &r, &rw, &cands);
+    // The selection, run again without any named effect the fit does not
+    // need once its noise is re-fitted without it (confirm.rs).
+    let mut not_confirmed: Vec<(Effect, f64)> = vec![];
+    let (d, sel, noise, tr, passes) = loop {
+        let now: Vec<Effect> = cands
+            .iter()
+            .copied()
+            .filter(|e| !not_confirmed.iter().any(|x| x.0 == *e))
+            .collect();
+        let out = passes(inp, &win, &r, &rw, &now);
+        if out.0.win.len() < MIN_COLOUR_WINDOWS || not_confirmed.len() >= confirm::MAX_SET_ASIDE {
+            break out;
+        }
+        match confirm::weakest(&out.0, &out.1, &out.2) {
+            Some(w) => not_confirmed.push(w),
+            None => break out,
+        }
+    };
     let short = short_record(&d, &sel);
-    let (role, amb_const, _) = constant::role(&d, &sel, &cands);
+    let (mut role, amb_const, _) = constant::role(&d, &sel, &cands);
+    if role == Role::Named && short.is_none() {
+        let g = confirm::constant_gain(&d, &sel, &noise);
+        if g < select::THRESHOLD {
+            not_confirmed.push((Effect::Bias, g));
+            let alone = sel.named.is_empty() && sel.carried.is_empty() && sel.nuisance.is_empty();
+            role = if alone { Role::Unneeded } else { Role::Carried };
+        }
+    }
     let terms = sel.terms();
     let mut fin = estimate(&d, &terms);
     if short.is_none() {
@@ -394,6 +430,10 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
             let why = match role {
                 Role::Named => None,
                 Role::Ambiguous => Some("the constant, for the ambiguous group it heads".into()),
+                _ if not_confirmed.iter().any(|x| x.0 == Effect::Bias) => Some(
+                    "the constant the other terms are fitted with (not named a bias: once the noise is re-fitted without it, it gains less than the threshold)"
+                        .into(),
+                ),
                 _ => Some(
                     "the constant the other terms are fitted with (no bias of its own: removing it, or letting a warm-up settle to nothing, costs less than the threshold)"
                         .into(),
@@ -485,6 +525,7 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
         implausible: sel.implausible.clone(),
         unexplained,
         dropped: sel.dropped.iter().map(|k| k.describe()).collect(),
+        not_confirmed,
         skipped,
         gap_before_dph: gap_before,
         gap_after_dph: gap_after,

@@ -274,6 +274,20 @@ pub fn fit_terms(
 /// less fixed parts `y` and a fit's raw columns `cols` (window means), the
 /// white level profiled out as the common scale.
 fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64>]) -> f64 {
+    loglik(m, win, keep, y, cols, true)
+}
+
+/// The log-likelihood of noise model `m` for `y` less the fit of `cols`:
+/// restricted ([`reml`]) or plain maximum likelihood (n in place of n - p,
+/// no Gram determinant: the one that compares fits of different columns).
+fn loglik(
+    m: &NoiseModel,
+    win: &Windows,
+    keep: &[bool],
+    y: &[f64],
+    cols: &[Vec<f64>],
+    restricted: bool,
+) -> f64 {
     let w = Whitener::new(m, win, keep);
     let yw = w.whiten(y);
     let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
@@ -296,6 +310,9 @@ fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64
     // slow noise the fitted shapes soaked up as absent, and the slow
     // levels, and with them the intervals, came out too small.
     let n = w.used() as f64;
+    if !restricted {
+        return -0.5 * (n * (sse / n.max(1.0)).max(1e-300).ln() + w.log_det());
+    }
     let p = cw.len() as f64;
     let gram = if cw.is_empty() {
         Some(0.0)
@@ -370,7 +387,20 @@ pub fn refine(
     y: &[f64],
     cols: &[Vec<f64>],
 ) -> NoiseModel {
-    let loglik = |m: &NoiseModel| reml(m, win, keep, y, cols);
+    profile(start, win, keep, y, cols, true).0
+}
+
+/// The noise model searched as [`refine`] does, by the restricted or the
+/// plain likelihood, and that likelihood at its best.
+pub fn profile(
+    start: &NoiseModel,
+    win: &Windows,
+    keep: &[bool],
+    y: &[f64],
+    cols: &[Vec<f64>],
+    restricted: bool,
+) -> (NoiseModel, f64) {
+    let loglik = |m: &NoiseModel| loglik(m, win, keep, y, cols, restricted);
     let mut m = *start;
     let floor = m.white * 1e-4;
     let mut best = loglik(&m);
@@ -399,7 +429,7 @@ pub fn refine(
             }
         }
     }
-    m
+    (m, best)
 }
 
 /// ln det of the Gram matrix of `cols` (None when it is singular).

@@ -425,6 +425,87 @@ fn open(d: &Design, candidates: &[Effect], st: &State) -> Vec<Term> {
     v
 }
 
+/// Exchanges a selection may make.
+pub const MAX_EXCHANGES: usize = 4;
+
+/// Exchanges tried in full per exchange step (the best of the quick
+/// trials).
+const EXCHANGE_TRIES: usize = 6;
+
+/// The criterion of `terms` once every non-linear parameter is re-fitted
+/// and every term (the constant aside) whose removal costs less than
+/// [`THRESHOLD`] is dropped, cheapest first.
+fn settled(d: &Design, mut terms: Vec<Term>) -> f64 {
+    for j in 0..terms.len() {
+        d.optimize(&mut terms, j);
+    }
+    loop {
+        let c = d.criterion_of(&terms);
+        let cheapest = (1..terms.len())
+            .map(|j| {
+                let rest: Vec<Term> = terms
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| *i != j)
+                    .map(|(_, t)| *t)
+                    .collect();
+                (j, d.criterion_of(&rest) - c)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match cheapest {
+            Some((j, cost)) if cost < THRESHOLD => {
+                terms.remove(j);
+            }
+            _ => return c,
+        }
+    }
+}
+
+/// The exchange step (sequential replacement), once nothing more comes in:
+/// each term in (named or unexplained) is tried replaced by each open
+/// candidate, the latter's non-linear parameter searched; the best few
+/// replacements are then settled (every non-linear parameter re-fitted,
+/// what the replacement makes redundant dropped). When one lowers the
+/// criterion by more than [`THRESHOLD`], the term it replaces and the
+/// kind that replaces it: the term leaves (it may come back), and the
+/// replacement comes in through the forward step's checks. A forward
+/// selection that took first what explains most of two effects together
+/// (a monoblock difference's square for a case temperature with a
+/// warm-up) otherwise keeps it, and the effects it imitates never come in.
+fn exchange(d: &Design, candidates: &[Effect], st: &State) -> Option<(usize, Term, Term)> {
+    let base = st.sel.terms();
+    let c_cur = d.criterion_of(&base);
+    let open = open(d, candidates, st);
+    let mut quick: Vec<(usize, Term, Term, f64)> = vec![];
+    for (list, t) in st.removable() {
+        if list == 1 {
+            continue;
+        }
+        let rest: Vec<Term> = base.iter().filter(|x| **x != t).copied().collect();
+        let Some(cur) = d.fit(&rest) else {
+            continue;
+        };
+        let c_rest = d.criterion_of(&rest);
+        for tr in trials(d, &open, &rest, &cur.resid, c_rest) {
+            if tr.term.kind != t.kind {
+                quick.push((list, t, tr.term, c_rest + tr.delta - c_cur));
+            }
+        }
+    }
+    quick.sort_by(|a, b| a.3.total_cmp(&b.3));
+    let mut best: Option<(usize, Term, Term, f64)> = None;
+    for (list, t, cand, _) in quick.into_iter().take(EXCHANGE_TRIES) {
+        let mut terms: Vec<Term> = base.iter().filter(|x| **x != t).copied().collect();
+        terms.push(cand);
+        let delta = settled(d, terms) - c_cur;
+        if best.as_ref().is_none_or(|b| delta < b.3) {
+            best = Some((list, t, cand, delta));
+        }
+    }
+    let (list, t, cand, delta) = best?;
+    (delta < -THRESHOLD).then_some((list, t, cand))
+}
+
 /// Stepwise selection over `candidates` (library effects; not the bias,
 /// whose constant every fit carries).
 pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
@@ -440,18 +521,39 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
         closed: vec![],
         closed_steps: vec![],
     };
+    let mut exchanges = 0;
+    let mut next_forced: Option<Term> = None;
     for _ in 0..4 * (candidates.len() + Shape::ALL.len() + d.steps.len() + 2) {
+        let forced = next_forced.take();
         let base = st.sel.terms();
         let Some(cur) = d.fit(&base) else {
             break;
         };
         let c_cur = d.criterion_of(&base);
         let ts = trials(d, &open(d, candidates, &st), &base, &cur.resid, c_cur);
-        let Some(mut best) = (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta))
+        let forced = forced.and_then(|k: Term| {
+            ts.iter()
+                .position(|t| t.term.kind == k.kind && (k.kind != Kind::Step || t.term.x == k.x))
+        });
+        let Some(mut best) =
+            forced.or_else(|| (0..ts.len()).min_by(|&a, &b| ts[a].delta.total_cmp(&ts[b].delta)))
         else {
             break;
         };
-        if ts[best].delta > -THRESHOLD {
+        if forced.is_none() && ts[best].delta > -THRESHOLD {
+            if exchanges < MAX_EXCHANGES {
+                if let Some((list, t, cand)) = exchange(d, candidates, &st) {
+                    exchanges += 1;
+                    let s = &mut st.sel;
+                    match list {
+                        0 => s.named.retain(|x| x.term != t),
+                        _ => s.nuisance.retain(|x| *x != t),
+                    }
+                    refit(d, s);
+                    next_forced = Some(cand);
+                    continue;
+                }
+            }
             break;
         }
         // A shape yields to an effect that explains the same as well.

@@ -94,17 +94,63 @@ impl Shape {
             Shape::TimeSquared => inp.t.iter().map(|t| ((t - t0) / span).powi(2)).collect(),
             Shape::TempSquared => temp.iter().map(|x| (x - 20.0).powi(2)).collect(),
             Shape::CaseSquared => case.iter().map(|x| (x - 20.0).powi(2)).collect(),
-            Shape::TempCurvature => {
-                let r = centered_slope(&inp.t, temp, CURVATURE_HALF_WIDTH_S);
-                centered_slope(&inp.t, &r, CURVATURE_HALF_WIDTH_S)
-            }
+            Shape::TempCurvature => curvature(&inp.t, temp, CURVATURE_HALF_WIDTH_S),
             Shape::CaseRate => centered_slope(&inp.t, case, RATE_HALF_WIDTH_S),
-            Shape::CaseCurvature => {
-                let r = centered_slope(&inp.t, case, CURVATURE_HALF_WIDTH_S);
-                centered_slope(&inp.t, &r, CURVATURE_HALF_WIDTH_S)
+            Shape::CaseCurvature => curvature(&inp.t, case, CURVATURE_HALF_WIDTH_S),
+        }
+    }
+}
+
+/// The second derivative of `x` over `t`, per s^2: the slope of its slope,
+/// each over `half` s either side, inside the record; within `2 half` of
+/// either end, where those slopes would be one-sided (a one-sided slope of
+/// a curving series is the slope at its window's centre, not at the row:
+/// the nested slopes halve a lag's start-up curvature at the record's
+/// first minutes, and that error reads as a step or a warm-up), the
+/// curvature of a local cubic over the rows within `2 half` (exact for a
+/// cubic, as the nested slopes are inside).
+pub fn curvature(t: &[f64], x: &[f64], half: f64) -> Vec<f64> {
+    let r = centered_slope(t, x, half);
+    let mut c = centered_slope(t, &r, half);
+    let n = t.len();
+    if n == 0 {
+        return c;
+    }
+    let reach = 2.0 * half;
+    let (t0, t1) = (t[0], t[n - 1]);
+    let edge = |k: usize| t[k] - t0 < reach || t1 - t[k] < reach;
+    for k in (0..n).filter(|&k| edge(k)) {
+        let lo = t.partition_point(|&v| v < t[k] - reach);
+        let hi = t.partition_point(|&v| v <= t[k] + reach);
+        if let Some(v) = local_cubic_curvature(&t[lo..hi], &x[lo..hi], t[k], reach) {
+            c[k] = v;
+        }
+    }
+    c
+}
+
+/// The second derivative at `at` of the least-squares cubic through
+/// (`t`, `x`) (times scaled by `scale` for the normal equations' sake);
+/// None with fewer than 6 rows or a singular fit.
+fn local_cubic_curvature(t: &[f64], x: &[f64], at: f64, scale: f64) -> Option<f64> {
+    if t.len() < 6 {
+        return None;
+    }
+    let mut a = nalgebra::Matrix4::<f64>::zeros();
+    let mut b = nalgebra::Vector4::<f64>::zeros();
+    for (&tk, &xk) in t.iter().zip(x) {
+        let u = (tk - at) / scale;
+        let p = [1.0, u, u * u, u * u * u];
+        for i in 0..4 {
+            b[i] += p[i] * xk;
+            for j in 0..4 {
+                a[(i, j)] += p[i] * p[j];
             }
         }
     }
+    let sol = a.cholesky()?.solve(&b);
+    let v = 2.0 * sol[2] / (scale * scale);
+    v.is_finite().then_some(v)
 }
 
 /// Whether the run turns: reaches [`ROTATING_DPS`].
@@ -167,5 +213,25 @@ pub struct Term {
 impl Term {
     pub fn of(kind: Kind) -> Self {
         Self { kind, x: 0.0 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curvature_is_exact_for_a_cubic_up_to_the_record_ends() {
+        // x = a t^3 + b t^2 over 1 h at 1 Hz: x'' = 6 a t + 2 b everywhere,
+        // the first and last rows included (the nested one-sided slopes
+        // there were off by up to half).
+        let (a, b) = (1e-10, 3e-6);
+        let t: Vec<f64> = (0..3600).map(|k| k as f64).collect();
+        let x: Vec<f64> = t.iter().map(|s| a * s * s * s + b * s * s).collect();
+        let c = curvature(&t, &x, CURVATURE_HALF_WIDTH_S);
+        for k in [0, 1, 60, 239, 240, 1800, 3360, 3500, 3599] {
+            let want = 6.0 * a * t[k] + 2.0 * b;
+            assert!((c[k] / want - 1.0).abs() < 1e-6, "{k}: {} vs {want}", c[k]);
+        }
     }
 }

@@ -2,8 +2,10 @@
 //! residual that the shapes, steps and implausible fits carry, the spikes,
 //! and the stretches where the whitened residual of the final fit still
 //! stands out of its noise (blocks of [`BLOCK_WINDOWS`] whose sum of
-//! standardised innovations is beyond [`BLOCK_SIGMAS`] sigmas); with its
-//! size, where it sits, and the inputs it follows most.
+//! standardised innovations is beyond [`BLOCK_SIGMAS`] sigmas, or whose sum
+//! of squares is beyond chi-square's quantile at the same tail: a burst
+//! that swings both ways, a vehicle rocking, sums to nothing but not its
+//! squares); with its size, where it sits, and the inputs it follows most.
 
 use super::design::Design;
 use super::noise_model::NoiseModel;
@@ -148,6 +150,33 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         .filter(|(_, c)| (c.iter().sum::<f64>() / sd).abs() > BLOCK_SIGMAS)
         .map(|(b, c)| (b * BLOCK_WINDOWS, b * BLOCK_WINDOWS + c.len() - 1))
         .collect();
+    // Blocks whose innovations' energy stands out: a burst that swings
+    // both ways. The residual itself is what is unexplained there.
+    // The two-sided tail of the sum's test: P(|Z| > BLOCK_SIGMAS).
+    let tail = statrs::function::erf::erfc(BLOCK_SIGMAS / std::f64::consts::SQRT_2);
+    let loud: Vec<(usize, usize)> = src
+        .whitened
+        .chunks(BLOCK_WINDOWS)
+        .enumerate()
+        .filter(|(b, c)| {
+            let k = c.len() as f64;
+            let used = d.wh.keep[b * BLOCK_WINDOWS..b * BLOCK_WINDOWS + c.len()]
+                .iter()
+                .filter(|x| **x)
+                .count() as f64;
+            let ss = c.iter().map(|v| v * v).sum::<f64>() / src.scale.max(1e-300);
+            used >= 0.5 * k && ss > crate::numerics::stats::chi2_quantile(1.0 - tail, used)
+        })
+        .map(|(b, c)| (b * BLOCK_WINDOWS, b * BLOCK_WINDOWS + c.len() - 1))
+        .filter(|x| !flagged.contains(x))
+        .collect();
+    for &(a, b) in &loud {
+        for k in a..=b {
+            if u[k] == 0.0 {
+                u[k] = src.after[k];
+            }
+        }
+    }
     let after_blocks = blocks(src.after);
     for &(a, b) in &flagged {
         let m = after_blocks[a / BLOCK_WINDOWS].2;
@@ -157,7 +186,7 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
             }
         }
     }
-    if src.parts.is_empty() && src.spikes.is_empty() && flagged.is_empty() {
+    if src.parts.is_empty() && src.spikes.is_empty() && flagged.is_empty() && loud.is_empty() {
         return None;
     }
     let excess = (u.iter().map(|v| v * v).sum::<f64>() / n.max(1) as f64).sqrt() * 3600.0;
@@ -189,7 +218,7 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
             }),
         }
     }
-    for &(a, b) in src.spikes {
+    for &(a, b) in src.spikes.iter().chain(&loud) {
         let peak =
             (a..=b)
                 .map(|k| src.after[k])
@@ -201,6 +230,20 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         });
     }
     spans.sort_by(|a, b| a.from_s.total_cmp(&b.from_s));
+    // Neighbouring or overlapping spans as one.
+    let mut merged: Vec<Span> = vec![];
+    for sp in spans {
+        match merged.last_mut() {
+            Some(m) if sp.from_s <= m.to_s + 2.0 * half => {
+                m.to_s = m.to_s.max(sp.to_s);
+                if sp.peak_dph.abs() > m.peak_dph.abs() {
+                    m.peak_dph = sp.peak_dph;
+                }
+            }
+            _ => merged.push(sp),
+        }
+    }
+    let spans = merged;
     let mut correlates: Vec<Correlate> = inputs(d)
         .into_iter()
         .map(|(name, x)| Correlate {
@@ -211,6 +254,12 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         .collect();
     correlates.sort_by(|a, b| b.correlation.abs().total_cmp(&a.correlation.abs()));
     let mut carried_by: Vec<String> = src.parts.iter().map(|p| p.1.clone()).collect();
+    if !loud.is_empty() {
+        carried_by.push(format!(
+            "{} stretch(es) of {BLOCK_WINDOWS} s where the residual swings beyond its noise",
+            loud.len()
+        ));
+    }
     if !flagged.is_empty() {
         carried_by.push(format!(
             "{} stretch(es) of {BLOCK_WINDOWS} s where the residual stands out of its noise",

@@ -1,0 +1,78 @@
+//! Confirmation of the effects named against the noise re-fitted without
+//! them (docs/discovery.md).
+//!
+//! The selection's criterion is taken on the problem whitened by one noise
+//! model, and that model is fitted given the selection's own columns. A
+//! slow effect then absorbs the slow noise (a random walk, a Markov
+//! wander) it imitates: the noise fitted with it reads no random walk, and
+//! on that noise the effect pays handsomely. A bias over temperature was
+//! named on a table run that held nothing but a random walk, whose noise
+//! model, fitted with it, read a twentieth of the random walk there was.
+//!
+//! So each named effect (and the constant, before it is called a bias)
+//! must pay against the noise fitted without it: twice the log-likelihood
+//! ratio of the fits with and without it, each side with its random walk,
+//! flicker and Markov levels re-fitted by maximum likelihood (plain, not
+//! restricted: the two sides have different columns), less the BIC's
+//! penalty for its parameters, must exceed the selection's
+//! [`THRESHOLD`]. An effect that does not is set aside, said so, and the
+//! selection run again without it.
+
+use super::design::Design;
+use super::noise_model::{profile, NoiseModel};
+use super::select::{Selection, THRESHOLD};
+use super::terms::{Kind, Term};
+use crate::model::effects::Effect;
+
+/// Effects set aside at most (then the selection stands as it is).
+pub const MAX_SET_ASIDE: usize = 3;
+
+/// What `terms[j]` gains the fit of `terms` once the noise is re-fitted
+/// on each side (its random walk, flicker and Markov levels by maximum
+/// likelihood, from `noise`): twice the log-likelihood ratio less its BIC
+/// penalty (the criterion's decrease, as the selection's delta with the
+/// sign turned). The side without the effect may raise its slow noise to
+/// imitate it, but pays for a level the rest of the record does not show:
+/// a decaying warm-up is not a random walk that happened to fall.
+/// `full` is [`loglik`] of `terms`.
+pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel, full: f64) -> f64 {
+    let rest: Vec<Term> = terms
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != j)
+        .map(|(_, t)| *t)
+        .collect();
+    2.0 * (full - loglik(d, &rest, noise)) - terms[j].kind.dof() as f64 * d.n().max(2.0).ln()
+}
+
+/// The fit of `terms`' log-likelihood, its noise's slow levels re-fitted
+/// by maximum likelihood from `noise`.
+pub fn loglik(d: &Design, terms: &[Term], noise: &NoiseModel) -> f64 {
+    let (cols, y) = d.raw_problem(terms);
+    profile(noise, d.win, &d.wh.keep, &y, &cols, false).1
+}
+
+/// The named effect the fit needs least once the noise is re-fitted
+/// without it, with its gain, when that gain is below [`THRESHOLD`].
+pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Effect, f64)> {
+    if sel.named.is_empty() {
+        return None;
+    }
+    let terms = sel.terms();
+    let full = loglik(d, &terms, noise);
+    terms
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| sel.named.iter().any(|s| s.term == **t))
+        .filter_map(|(j, t)| Some((t.kind.effect()?, gain(d, &terms, j, noise, full))))
+        .filter(|(_, g)| *g < THRESHOLD)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// What the constant gains the final fit once the noise is re-fitted
+/// without it.
+pub fn constant_gain(d: &Design, sel: &Selection, noise: &NoiseModel) -> f64 {
+    let terms = sel.terms();
+    debug_assert_eq!(terms[0].kind, Kind::Constant);
+    gain(d, &terms, 0, noise, loglik(d, &terms, noise))
+}
