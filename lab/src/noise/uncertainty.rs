@@ -26,7 +26,10 @@
 //!   curve stands above a measured interval (it contradicts the curve).
 
 use super::edf::interval;
-use super::model::{Correlated, Curve, Fitted, Goodness, Interval, Sinusoid, TermFit};
+use super::model::{
+    sin_beat_sd, Correlated, Curve, Fitted, Goodness, Interval, Sinusoid, TermFit,
+};
+use super::profile::{self, Which};
 use super::terms::{ALL, CONF, COUNT, MARKOV, SIN};
 use crate::numerics::stats::{chi2_quantile, normal_quantile};
 use nalgebra::DMatrix;
@@ -64,6 +67,8 @@ pub struct Checked {
     pub by_likelihood: [bool; ALL],
     pub params: Vec<Param>,
     pub cov: Option<DMatrix<f64>>,
+    /// `(J'WJ)^-1`, the cost's inverse curvature.
+    pub naive: Option<DMatrix<f64>>,
 }
 
 fn z95() -> f64 {
@@ -92,7 +97,10 @@ fn sds(f: &Fitted) -> Vec<f64> {
         .collect()
 }
 
-/// The estimates' correlation matrix under the model.
+/// The estimates' correlation matrix under the model: the noise's scatter,
+/// correlated per noise type as the share-weighted sum of the types'
+/// kernels, plus the sinusoid's beat with the noise, one variable for the
+/// whole curve (model.rs, `sin_beat_sd`).
 pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
     let n = c.taus.len();
     let share: Vec<[f64; ALL]> = (0..n)
@@ -112,14 +120,23 @@ pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
             s
         })
         .collect();
+    let sd = sds(f);
+    let beat: Vec<f64> = (0..n)
+        .map(|i| {
+            let b = sin_beat_sd(&f.shapes, c.taus[i], c.tau0(), c.n_phase);
+            (b / sd[i].max(f64::MIN_POSITIVE)).min(1.0)
+        })
+        .collect();
     DMatrix::from_fn(n, n, |i, j| {
         if i == j {
             return 1.0;
         }
         let r = c.taus[i].max(c.taus[j]) / c.taus[i].min(c.taus[j]);
-        (0..ALL)
+        let noise: f64 = (0..ALL)
             .map(|t| (share[i][t] * share[j][t]).sqrt() * kernel(t, r))
-            .sum()
+            .sum();
+        let rest = ((1.0 - beat[i] * beat[i]) * (1.0 - beat[j] * beat[j])).sqrt();
+        noise * rest + beat[i] * beat[j]
     })
 }
 
@@ -179,8 +196,10 @@ fn derivative(f: &Fitted, p: Param, tau: f64) -> f64 {
     }
 }
 
-/// The sandwich covariance of the model's parameters.
-fn covariance(c: &Curve, f: &Fitted, ps: &[Param]) -> Option<DMatrix<f64>> {
+/// The sandwich covariance of the model's parameters, and the naive one
+/// `(J'WJ)^-1` (the inverse curvature of the weighted cost, W the inverse
+/// variances: what the cost's rise measures, profile.rs).
+fn covariance(c: &Curve, f: &Fitted, ps: &[Param]) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
     let (n, p) = (c.taus.len(), ps.len());
     if p == 0 || n < p {
         return None;
@@ -198,7 +217,10 @@ fn covariance(c: &Curve, f: &Fitted, ps: &[Param]) -> Option<DMatrix<f64>> {
     let meat = wx.transpose() * sigma * &wx;
     let cov = &bread * meat * &bread;
     let out = DMatrix::from_fn(p, p, |a, b| cov[(a, b)] / (scale[a] * scale[b]));
-    (0..p).all(|k| out[(k, k)].is_finite()).then_some(out)
+    let naive = DMatrix::from_fn(p, p, |a, b| bread[(a, b)] / (scale[a] * scale[b]));
+    (0..p)
+        .all(|k| out[(k, k)].is_finite() && naive[(k, k)].is_finite())
+        .then_some((out, naive))
 }
 
 /// Whether shape j carries at least half of the model somewhere.
@@ -210,7 +232,9 @@ fn shows(c: &Curve, f: &Fitted, j: usize) -> bool {
 /// somewhere, and an interval of the coefficient that excludes zero.
 pub fn check(c: &Curve, f: &Fitted) -> Checked {
     let ps = params(f);
-    let cov = covariance(c, f, &ps);
+    let both = covariance(c, f, &ps);
+    let naive = both.as_ref().map(|b| b.1.clone());
+    let cov = both.map(|b| b.0);
     let mut present = [false; ALL];
     let mut significance = [0.0; ALL];
     match &cov {
@@ -242,6 +266,7 @@ pub fn check(c: &Curve, f: &Fitted) -> Checked {
         by_likelihood: [false; ALL],
         params: ps,
         cov,
+        naive,
     }
 }
 
@@ -275,6 +300,50 @@ fn goodness(c: &Curve, f: &Fitted, n_params: usize) -> Goodness {
 /// Shape j's share of the model at averaging time i.
 fn share(c: &Curve, f: &Fitted, j: usize, i: usize) -> f64 {
     f.shapes.part(j, c.taus[i]) / f.model[i]
+}
+
+/// `i` widened to hold `(lo, hi)`.
+fn widen(i: &mut Interval, (lo, hi): (f64, f64)) {
+    i.lo = i.lo.min(lo);
+    i.hi = i.hi.max(hi);
+}
+
+/// The profile intervals of the sinusoid or the Markov term (profile.rs),
+/// from the parameters' sandwich and naive covariances and their variance
+/// inflations `lambda`.
+fn profile_of(
+    c: &Curve,
+    f: &Fitted,
+    chk: &Checked,
+    lambda: &[f64],
+    which: Which,
+) -> Option<profile::Profile> {
+    let (sand, naive) = (chk.cov.as_ref()?, chk.naive.as_ref()?);
+    let (j, lp) = match which {
+        Which::Sin => (SIN, Param::LnF),
+        Which::Markov => (MARKOV, Param::LnT),
+    };
+    let kc = chk.params.iter().position(|&p| p == Param::Coef(j))?;
+    let kp = chk.params.iter().position(|&p| p == lp)?;
+    let cj = f.shapes.c[j];
+    // Variance of the log size: ln A = ln c / 2; ln sigma = (ln c + ln T) / 2.
+    let size_var = |m: &DMatrix<f64>| match which {
+        Which::Sin => 0.25 * m[(kc, kc)] / (cj * cj),
+        Which::Markov => {
+            0.25 * (m[(kc, kc)] / (cj * cj) + m[(kp, kp)] + 2.0 * m[(kc, kp)] / cj)
+        }
+    };
+    let param = profile::Spread {
+        sandwich: sand[(kp, kp)],
+        naive: naive[(kp, kp)],
+        inflation: lambda[kp],
+    };
+    let size = profile::Spread {
+        sandwich: size_var(sand),
+        naive: size_var(naive),
+        inflation: lambda[kc],
+    };
+    profile::profile(c, f, which, param, size, z95())
 }
 
 /// The fit made into the report: goodness, honest intervals, reliability.
@@ -348,21 +417,28 @@ pub fn finish(c: &Curve, f: Fitted, chk: Checked) -> TermFit {
         lo[j] = lo[j].max(0.0);
     }
     let index = |want: Param| ps.iter().position(|&p| p == want);
+    let profiled = |which: Which| profile_of(c, &f, &chk, &lambda, which);
     let sinusoid = (f.has(SIN)).then(|| {
         let (a2, a2lo, a2hi) = (f.shapes.c[SIN], lo[SIN], hi[SIN]);
         let k = index(Param::LnF);
         let sf = k.map_or(f64::INFINITY, |k| se[k]);
+        let mut amplitude = Interval {
+            value: a2.sqrt(),
+            lo: a2lo.max(0.0).sqrt(),
+            hi: a2hi.max(0.0).sqrt(),
+        };
+        let mut frequency = Interval {
+            value: f.shapes.f,
+            lo: f.shapes.f * (-zq * sf).exp(),
+            hi: f.shapes.f * (zq * sf).exp(),
+        };
+        if let Some(pr) = profiled(Which::Sin) {
+            widen(&mut amplitude, pr.size);
+            widen(&mut frequency, pr.param);
+        }
         Sinusoid {
-            amplitude_dps: Interval {
-                value: a2.sqrt(),
-                lo: a2lo.max(0.0).sqrt(),
-                hi: a2hi.max(0.0).sqrt(),
-            },
-            frequency_hz: Interval {
-                value: f.shapes.f,
-                lo: f.shapes.f * (-zq * sf).exp(),
-                hi: f.shapes.f * (zq * sf).exp(),
-            },
+            amplitude_dps: amplitude,
+            frequency_hz: frequency,
             reliable: reliable[SIN],
         }
     });
@@ -382,17 +458,23 @@ pub fn finish(c: &Curve, f: Fitted, chk: Checked) -> TermFit {
         let white = super::terms::markov_white_dpsh(q2, t);
         let s_white = (0.25 * wq + vt + cqt).max(0.0).sqrt();
         let ratio = |s: f64| (zq * s).exp();
+        let mut sigma_dph = Interval {
+            value: sigma,
+            lo: sigma / ratio(s_sigma),
+            hi: sigma * ratio(s_sigma),
+        };
+        let mut tau_s = Interval {
+            value: t,
+            lo: t / ratio(vt.sqrt()),
+            hi: t * ratio(vt.sqrt()),
+        };
+        if let Some(pr) = profiled(Which::Markov) {
+            widen(&mut sigma_dph, (pr.size.0 * 3600.0, pr.size.1 * 3600.0));
+            widen(&mut tau_s, pr.param);
+        }
         Correlated {
-            sigma_dph: Interval {
-                value: sigma,
-                lo: sigma / ratio(s_sigma),
-                hi: sigma * ratio(s_sigma),
-            },
-            tau_s: Interval {
-                value: t,
-                lo: t / ratio(vt.sqrt()),
-                hi: t * ratio(vt.sqrt()),
-            },
+            sigma_dph,
+            tau_s,
             white_limit_dpsh: Interval {
                 value: white,
                 lo: white / ratio(s_white),
@@ -440,6 +522,7 @@ pub fn finish(c: &Curve, f: Fitted, chk: Checked) -> TermFit {
         lo: plo,
         hi: phi,
         reliable: prel,
+        bias_upper_bound: false,
         sinusoid,
         correlated,
         arw_filter_s,
