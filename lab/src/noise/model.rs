@@ -3,7 +3,7 @@
 //! intervals and the goodness of fit; and the degrees of freedom of a
 //! mixture of noise types.
 
-use super::edf::edf_oavar;
+use super::edf::{edf_oavar, markov_edf_per_length};
 use super::terms::{shape, ALL, ALPHA, COUNT, MARKOV, SIN};
 
 /// The coefficients of the seven shapes (terms.rs: c_j >= 0, zero where
@@ -145,10 +145,16 @@ impl Fitted {
 }
 
 /// Degrees of freedom of the Markov term's estimates at tau: a rate random
-/// walk well below its correlation time, white noise well above, combined
-/// as a mixture is.
+/// walk well below its correlation time, white noise well above; in
+/// between, Greenhall's two combined as a mixture is, with the random
+/// walk's weight s that gives the asymptotic value of the Markov spectrum
+/// ([`markov_edf_per_length`]); Greenhall's finite-record forms at both
+/// ends.
 fn markov_inv_sqrt_edf(tau: f64, t: f64, m: usize, n_phase: usize) -> f64 {
-    let s = 1.0 / (1.0 + tau / t);
+    let (rw, white) = (1.0 / 1.079f64, 1.5f64);
+    let rho = markov_edf_per_length(tau / t).clamp(rw, white);
+    let s = ((1.0 / rho.sqrt() - 1.0 / white.sqrt()) / (1.0 / rw.sqrt() - 1.0 / white.sqrt()))
+        .clamp(0.0, 1.0);
     s / edf_oavar(-2, m, n_phase).sqrt() + (1.0 - s) / edf_oavar(0, m, n_phase).sqrt()
 }
 

@@ -27,7 +27,7 @@
 
 use super::edf::interval;
 use super::model::{
-    sin_beat_sd, Correlated, Curve, Fitted, Goodness, Interval, Sinusoid, TermFit,
+    noise_psd, sin_beat_sd, Correlated, Curve, Fitted, Goodness, Interval, Sinusoid, TermFit,
 };
 use super::profile::{self, Which};
 use super::terms::{ALL, CONF, COUNT, MARKOV, SIN};
@@ -75,16 +75,17 @@ fn z95() -> f64 {
     normal_quantile(0.5 + CONF / 2.0)
 }
 
-/// Correlation of two AVAR estimates of shape t at taus with ratio r >= 1.
+/// Correlation of two AVAR estimates at taus with ratio r >= 1 for the two
+/// shapes not taken through their spectrum ([`spectral_correlation`]):
+/// quantization (Monte Carlo on the project's generators, about 0.3 at any
+/// ratio) and the ramp (no noise: a random walk's degrees of freedom, its
+/// kernel).
 fn kernel(t: usize, r: f64) -> f64 {
     if r == 1.0 {
         return 1.0;
     }
     match t {
         0 => 0.3,
-        1 => r.powf(-1.1),
-        2 | MARKOV => r.powf(-0.7),
-        SIN => 0.0,
         _ => r.powf(-0.35),
     }
 }
@@ -97,33 +98,97 @@ fn sds(f: &Fitted) -> Vec<f64> {
         .collect()
 }
 
-/// The estimates' correlation matrix under the model: the noise's scatter,
-/// correlated per noise type as the share-weighted sum of the types'
-/// kernels, plus the sinusoid's beat with the noise, one variable for the
-/// whole curve (model.rs, `sin_beat_sd`).
-pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
-    let n = c.taus.len();
-    let share: Vec<[f64; ALL]> = (0..n)
+/// Frequencies per decade of the spectral integral, and the phase pi f tau
+/// beyond which a filter's oscillation is replaced by its mean.
+const PER_DECADE_F: f64 = 20.0;
+const ENVELOPE_X: f64 = 3.0 * std::f64::consts::PI;
+
+/// The correlation of the AVAR estimates at `taus` for Gaussian noise of
+/// one-sided PSD `psd` (rate, any mixture). An estimate at tau is the mean
+/// square of the Allan difference, whose power response is |H(f)|^2 = 4
+/// sin^4(pi f tau) / (pi f tau)^2; for a record of length T much longer
+/// than both taus, Cov(V_i, V_j) = (1/4T) int S(f)^2 |H_i|^2 |H_j|^2 df
+/// (Isserlis; Parseval over the lags). The integral on a log grid of
+/// frequency from 0.01/tau_max to Nyquist, 20 a decade, |H|^2 by its mean
+/// 1.5/x^2 (and |H|^4 by 16 (35/128)/x^4) where x = pi f tau > 3 pi. Against
+/// the generators (400 records of 20 000 s, adjacent octaves / a decade
+/// apart): white 0.50 / 0.03 (this 0.53 / 0.05), flicker 0.69 / 0.07 (0.69
+/// / 0.09), random walk 0.88 / 0.40 (0.89 / 0.44), Markov T = 20 s at 2-4,
+/// 20-40, 100-200 s 0.86, 0.76, 0.50 (0.87, 0.77, 0.58).
+pub fn spectral_correlation(taus: &[f64], tau0: f64, psd: impl Fn(f64) -> f64) -> DMatrix<f64> {
+    let n = taus.len();
+    let (f0, f1) = (0.01 / taus[n - 1], 0.5 / tau0);
+    let k = ((f1 / f0).log10() * PER_DECADE_F).ceil().max(1.0) as usize;
+    let dl = (f1 / f0).ln() / k as f64;
+    let freqs: Vec<f64> = (0..=k).map(|i| f0 * (dl * i as f64).exp()).collect();
+    let weight: Vec<f64> = freqs.iter().map(|&f| psd(f).powi(2) * f * dl).collect();
+    let h = |f: f64, tau: f64| {
+        let x = std::f64::consts::PI * f * tau;
+        if x > ENVELOPE_X {
+            (1.5 / (x * x), 16.0 * 35.0 / 128.0 / x.powi(4))
+        } else {
+            let v = 4.0 * x.sin().powi(4) / (x * x);
+            (v, v * v)
+        }
+    };
+    let a = DMatrix::from_fn(n, freqs.len(), |i, q| h(freqs[q], taus[i]).0 * weight[q].sqrt());
+    let diag: Vec<f64> = (0..n)
         .map(|i| {
-            let mut s = [0.0; ALL];
-            for (t, v) in s.iter_mut().enumerate() {
-                if t != SIN {
-                    *v = f.shapes.part(t, c.taus[i]).max(0.0);
-                }
-            }
-            let tot: f64 = s.iter().sum();
-            if tot > 0.0 {
-                s.iter_mut().for_each(|v| *v /= tot);
-            } else {
-                s[1] = 1.0;
-            }
-            s
+            freqs
+                .iter()
+                .zip(&weight)
+                .map(|(&f, w)| w * h(f, taus[i]).1)
+                .sum::<f64>()
         })
         .collect();
+    let cov = &a * a.transpose();
+    DMatrix::from_fn(n, n, |i, j| {
+        if i == j {
+            1.0
+        } else {
+            let d = (diag[i] * diag[j]).sqrt();
+            if d > 0.0 {
+                (cov[(i, j)] / d).clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        }
+    })
+}
+
+/// The estimates' correlation matrix under the model: the noise's scatter
+/// through its spectrum ([`spectral_correlation`], every noise type but
+/// quantization and the ramp, which weigh in by their shares with their
+/// own kernels), plus the sinusoid's beat with the noise, one variable for
+/// the whole curve (model.rs, `sin_beat_sd`).
+pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
+    let n = c.taus.len();
+    let tau0 = c.tau0();
+    // Shares of the estimate's noise: quantization, ramp, the rest.
+    let share: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let tau = c.taus[i];
+            let q = f.shapes.part(0, tau).max(0.0);
+            let r = f.shapes.part(4, tau).max(0.0);
+            let rest: f64 = (1..ALL)
+                .filter(|&t| t != 4 && t != SIN)
+                .map(|t| f.shapes.part(t, tau).max(0.0))
+                .sum();
+            let tot = q + r + rest;
+            if tot > 0.0 {
+                [q / tot, r / tot, rest / tot]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    let mut spectral_shapes = f.shapes;
+    spectral_shapes.c[0] = 0.0;
+    let spec = spectral_correlation(c.taus, tau0, |fr| noise_psd(&spectral_shapes, fr, tau0));
     let sd = sds(f);
     let beat: Vec<f64> = (0..n)
         .map(|i| {
-            let b = sin_beat_sd(&f.shapes, c.taus[i], c.tau0(), c.n_phase);
+            let b = sin_beat_sd(&f.shapes, c.taus[i], tau0, c.n_phase);
             (b / sd[i].max(f64::MIN_POSITIVE)).min(1.0)
         })
         .collect();
@@ -132,9 +197,10 @@ pub fn correlation(c: &Curve, f: &Fitted) -> DMatrix<f64> {
             return 1.0;
         }
         let r = c.taus[i].max(c.taus[j]) / c.taus[i].min(c.taus[j]);
-        let noise: f64 = (0..ALL)
-            .map(|t| (share[i][t] * share[j][t]).sqrt() * kernel(t, r))
-            .sum();
+        let (a, b) = (share[i], share[j]);
+        let noise = (a[0] * b[0]).sqrt() * kernel(0, r)
+            + (a[1] * b[1]).sqrt() * kernel(4, r)
+            + (a[2] * b[2]).sqrt() * spec[(i, j)];
         let rest = ((1.0 - beat[i] * beat[i]) * (1.0 - beat[j] * beat[j])).sqrt();
         noise * rest + beat[i] * beat[j]
     })
