@@ -199,9 +199,12 @@ pub fn sin_beat_sd(sh: &Shapes, tau: f64, tau0: f64, n_phase: usize) -> f64 {
 /// type's share s_t with its own (Greenhall) degrees of freedom, combined
 /// as if fully correlated, `1/sqrt(edf) = sum s_t / sqrt(edf_t)` (a
 /// mixture's estimate is no steadier than its noisiest part). A sinusoid
-/// adds no scatter of its own but beats with the noise ([`sin_beat_sd`]):
-/// the estimate's variance is 2 P_n^2 / edf_n + beat^2, P_n the noise's
-/// part.
+/// adds no scatter of its own; its beat with the noise ([`sin_beat_sd`])
+/// moves every estimate along the sinusoid's own shape, so it leaves the
+/// residuals alone and is not counted here: the fit's weights and the
+/// chi-square take 2 P_n^2 / edf_n, P_n the noise's part; the beat enters
+/// the parameters' covariance and the measured intervals
+/// (uncertainty.rs).
 pub fn mixture_edf(sh: &Shapes, model: f64, tau: f64, m: usize, n_phase: usize) -> f64 {
     let mut s = 0.0;
     let mut noise = 0.0;
@@ -222,9 +225,7 @@ pub fn mixture_edf(sh: &Shapes, model: f64, tau: f64, m: usize, n_phase: usize) 
         return edf_oavar(0, m, n_phase);
     }
     let edf_n = (noise * noise / (s * s)).max(1.0);
-    let beat = sin_beat_sd(sh, tau, tau / m as f64, n_phase);
-    let var = 2.0 * noise * noise / edf_n + beat * beat;
-    (2.0 * model * model / var).max(1.0)
+    (model * model * edf_n / (noise * noise)).max(1.0)
 }
 
 /// The model against the measured curve.
