@@ -175,7 +175,10 @@ pub fn recovery(
 ) -> Result<Recovery, AllanError> {
     let mut rows = vec![];
     let seeds = sel.seeds;
-    for sc in SCENARIOS.iter().filter(|s| s.name.contains(sel.only.as_str())) {
+    for sc in SCENARIOS
+        .iter()
+        .filter(|s| s.name.contains(sel.only.as_str()))
+    {
         let mut row = Row {
             scenario: sc.name,
             ..Row::default()

@@ -17,9 +17,7 @@ use crate::data::csv_writer::CellFormat::{Exp, Fixed};
 use crate::data::run_file::{Column, RunWriter, Series};
 use crate::error::LabError;
 use crate::noise::analysis::{analyse, Allan};
-use crate::noise::terms::{
-    to_units, ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS,
-};
+use crate::noise::terms::{to_units, ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS};
 use crate::sim::scale_factor_rig::RigParams;
 use clap::{Args, Subcommand};
 
@@ -279,7 +277,11 @@ fn allan(a: &AllanBenchArgs) -> Result<(), LabError> {
         return Err(LabError::Usage(format!("--seeds {}: 1..=10000", a.seeds)));
     }
     let bar = progress_bar(
-        a.seeds * SCENARIOS.iter().filter(|s| s.name.contains(a.only.as_str())).count() as u64,
+        a.seeds
+            * SCENARIOS
+                .iter()
+                .filter(|s| s.name.contains(a.only.as_str()))
+                .count() as u64,
         "{bar:40} {pos}/{len} records {eta}",
         a.json.json,
     );
@@ -351,8 +353,12 @@ fn print_misses(sc: &Scenario, seed: u64, an: &Allan) {
             _ => "not reported".into(),
         };
         let truth = match j {
-            SIN => t.sinusoid.map_or(String::new(), |(a, f)| format!("{a} deg/h at {f} Hz")),
-            MARKOV => t.markov.map_or(String::new(), |(s, c)| format!("{s} deg/h, {c} s")),
+            SIN => t
+                .sinusoid
+                .map_or(String::new(), |(a, f)| format!("{a} deg/h at {f} Hz")),
+            MARKOV => t
+                .markov
+                .map_or(String::new(), |(s, c)| format!("{s} deg/h, {c} s")),
             j => format!("{}", t.laws[j]),
         };
         println!(
@@ -360,7 +366,11 @@ fn print_misses(sc: &Scenario, seed: u64, an: &Allan) {
             sc.name,
             SHORT[j],
             tf.goodness.chi2_per_dof,
-            if tf.goodness.consistent { "" } else { " (inconsistent)" }
+            if tf.goodness.consistent {
+                ""
+            } else {
+                " (inconsistent)"
+            }
         );
     }
 }

@@ -140,7 +140,9 @@ pub fn markov_edf_per_length(x: f64) -> f64 {
             let (mut a, mut b) = (0.0, 0.0);
             for i in 0..=k {
                 let f = 1e-6 * (dl * i as f64).exp();
-                let sp = tc.map_or(1.0, |t| 1.0 / (1.0 + (std::f64::consts::TAU * f * t).powi(2)));
+                let sp = tc.map_or(1.0, |t| {
+                    1.0 / (1.0 + (std::f64::consts::TAU * f * t).powi(2))
+                });
                 let x = std::f64::consts::PI * f;
                 let (h2, h4) = if x > 3.0 * std::f64::consts::PI {
                     (1.5 / (x * x), 16.0 * 35.0 / 128.0 / x.powi(4))

@@ -115,7 +115,11 @@ fn hull(xs: &[f64], d: &[f64], thr: f64) -> Option<(f64, f64)> {
         xs[i] + t * (xs[o] - xs[i])
     };
     let lo = if a > 0 { cross(a, a - 1) } else { xs[0] };
-    let hi = if b + 1 < xs.len() { cross(b, b + 1) } else { xs[b] };
+    let hi = if b + 1 < xs.len() {
+        cross(b, b + 1)
+    } else {
+        xs[b]
+    };
     Some((lo, hi))
 }
 
@@ -130,7 +134,7 @@ pub fn profile(
     z: f64,
 ) -> Option<Profile> {
     let j0 = which.shape();
-    if !fit.has(j0) || !(param.sd() > 0.0 && size.sd() > 0.0) {
+    if !(fit.has(j0) && param.sd() > 0.0 && size.sd() > 0.0) {
         return None;
     }
     let w: Vec<f64> = fit
@@ -157,7 +161,10 @@ pub fn profile(
     let lps: Vec<f64> = (0..=2 * k)
         .map(|i| lp0 - half + half * i as f64 / k as f64)
         .collect();
-    let costs: Vec<f64> = lps.iter().map(|&lp| cost(c, fit, &w, which, lp, None)).collect();
+    let costs: Vec<f64> = lps
+        .iter()
+        .map(|&lp| cost(c, fit, &w, which, lp, None))
+        .collect();
     let best = costs
         .iter()
         .copied()

@@ -141,7 +141,9 @@ pub fn spectral_correlation(taus: &[f64], tau0: f64, psd: impl Fn(f64) -> f64) -
             (v, v * v)
         }
     };
-    let a = DMatrix::from_fn(n, freqs.len(), |i, q| h(freqs[q], taus[i]).0 * weight[q].sqrt());
+    let a = DMatrix::from_fn(n, freqs.len(), |i, q| {
+        h(freqs[q], taus[i]).0 * weight[q].sqrt()
+    });
     let diag: Vec<f64> = (0..n)
         .map(|i| {
             freqs
@@ -419,9 +421,7 @@ fn profile_of(
     // Variance of the log size: ln A = ln c / 2; ln sigma = (ln c + ln T) / 2.
     let size_var = |m: &DMatrix<f64>| match which {
         Which::Sin => 0.25 * m[(kc, kc)] / (cj * cj),
-        Which::Markov => {
-            0.25 * (m[(kc, kc)] / (cj * cj) + m[(kp, kp)] + 2.0 * m[(kc, kp)] / cj)
-        }
+        Which::Markov => 0.25 * (m[(kc, kc)] / (cj * cj) + m[(kp, kp)] + 2.0 * m[(kc, kp)] / cj),
     };
     let param = profile::Spread {
         sandwich: sand[(kp, kp)],
