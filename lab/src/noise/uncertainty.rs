@@ -626,3 +626,27 @@ pub fn finish(c: &Curve, f: Fitted, chk: Checked) -> TermFit {
         goodness: good,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::spectral_correlation;
+
+    #[test]
+    fn spectral_correlation_matches_the_generators_monte_carlo() {
+        // Monte Carlo on the project's generators (400 records of 20 000 s,
+        // docs/notes/issue-21-allan.md): correlation of the estimates at 2
+        // and 4 s, and at 2 and 20 s.
+        let taus = [2.0, 4.0, 20.0];
+        let cases: [(&str, fn(f64) -> f64, f64, f64); 3] = [
+            ("white", |_| 1.0, 0.50, 0.03),
+            ("flicker", |f| 1.0 / f, 0.69, 0.11),
+            ("random walk", |f| 1.0 / (f * f), 0.89, 0.43),
+        ];
+        for (name, psd, octave, decade) in cases {
+            let r = spectral_correlation(&taus, 1.0, psd);
+            assert!((r[(0, 1)] - octave).abs() < 0.05, "{name}: {}", r[(0, 1)]);
+            assert!((r[(0, 2)] - decade).abs() < 0.05, "{name}: {}", r[(0, 2)]);
+            assert_eq!(r[(1, 1)], 1.0);
+        }
+    }
+}
