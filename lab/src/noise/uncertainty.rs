@@ -637,7 +637,8 @@ mod tests {
         // docs/notes/issue-21-allan.md): correlation of the estimates at 2
         // and 4 s, and at 2 and 20 s.
         let taus = [2.0, 4.0, 20.0];
-        let cases: [(&str, fn(f64) -> f64, f64, f64); 3] = [
+        type Psd = fn(f64) -> f64;
+        let cases: [(&str, Psd, f64, f64); 3] = [
             ("white", |_| 1.0, 0.50, 0.03),
             ("flicker", |f| 1.0 / f, 0.69, 0.11),
             ("random walk", |f| 1.0 / (f * f), 0.89, 0.43),
