@@ -1,13 +1,13 @@
 //! How far a fitted noise model can be trusted (docs/noise.md):
 //!
 //! - The estimates' covariance: variance 2 AVAR^2/edf each, correlated
-//!   between averaging times (overlapping estimates share samples). Per
-//!   noise type the correlation of the estimates at tau1 < tau2 (Monte
-//!   Carlo on the project's generators) falls as (tau1/tau2)^beta, beta 1.1
-//!   for white rate noise, 0.7 for flicker (and a Markov term), 0.35 for
-//!   random walk, and is about 0.3 at any ratio for white angle noise; a
-//!   mixture's estimates correlate as the share-weighted sum of these. A
-//!   sinusoid adds no scatter.
+//!   between averaging times (overlapping estimates share samples) as the
+//!   fitted noise's spectrum says ([`spectral_correlation`]; it matches the
+//!   Monte Carlo on the project's generators); quantization (about 0.3 at
+//!   any ratio) and the ramp weigh in by their shares. A sinusoid adds no
+//!   scatter of its own; its beat with the noise is one variable for the
+//!   whole curve, along the sinusoid's shape: a rank-one term of the
+//!   parameters' covariance, not of the residuals'.
 //! - The parameters' covariance: the sandwich `(J'WJ)^-1 J'W S W J
 //!   (J'WJ)^-1`, J the model's derivatives (the coefficients, and the log
 //!   of the sinusoid's frequency and of the Markov correlation time), S the
