@@ -158,10 +158,27 @@ pub struct Recovery {
     pub false_reports_of: u64,
 }
 
-/// Every scenario over seeds 1..=`seeds`; `progress` after each record.
-pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, AllanError> {
+/// Which records the bench runs: seeds `first_seed..first_seed + seeds`
+/// of the scenarios whose name contains `only` (all when empty).
+#[derive(Clone, Debug)]
+pub struct Selection {
+    pub first_seed: u64,
+    pub seeds: u64,
+    pub only: String,
+}
+
+/// Every selected scenario over the selected seeds; `each` after each
+/// record, with its scenario, seed and analysis.
+pub fn recovery(
+    sel: &Selection,
+    mut each: impl FnMut(&Scenario, u64, &Allan),
+) -> Result<Recovery, AllanError> {
     let mut rows = vec![];
-    for sc in SCENARIOS {
+    let seeds = sel.seeds;
+    for sc in SCENARIOS
+        .iter()
+        .filter(|s| s.name.contains(sel.only.as_str()))
+    {
         let mut row = Row {
             scenario: sc.name,
             ..Row::default()
@@ -176,7 +193,7 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
                 row.false_reports[j] = Some(0);
             }
         }
-        for seed in 1..=seeds {
+        for seed in sel.first_seed..sel.first_seed + seeds {
             let y = if sc.truth.sinusoid.is_none() && sc.truth.markov.is_none() {
                 record(&sc.truth.laws, SAMPLES, TAU0_S, seed)
             } else {
@@ -199,7 +216,7 @@ pub fn recovery(seeds: u64, mut progress: impl FnMut()) -> Result<Recovery, Alla
                     row.false_reports[j] = row.false_reports[j].map(|c| c + 1);
                 }
             }
-            progress();
+            each(sc, seed, &an);
         }
         for j in 0..ALL {
             if present[j] && counts[j] > 0 {

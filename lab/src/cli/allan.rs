@@ -56,6 +56,9 @@ fn terms_json(a: &Allan) -> serde_json::Map<String, serde_json::Value> {
             })
             .unwrap_or(serde_json::Value::Null);
             v["reliable"] = t.reliable[j].into();
+            if j == 2 {
+                v["upper_bound"] = t.bias_upper_bound.into();
+            }
             if let (1, Some(f)) = (j, &t.arw_filter_s) {
                 v["filter_tau_s"] = iv(f, 1.0);
             }
@@ -291,8 +294,13 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
     let mut rows: Vec<Vec<String>> = (0..COUNT)
         .map(|j| {
             if t.present[j] {
+                let bounded = j == 2 && t.bias_upper_bound;
                 row(
-                    NAMES[j],
+                    if bounded {
+                        "bias_instability_dph (upper bound: floor not resolved)"
+                    } else {
+                        NAMES[j]
+                    },
                     SLOPES[j],
                     terms::to_units(j, t.c[j]),
                     terms::to_units(j, t.lo[j]),

@@ -3,8 +3,8 @@
 //! JSON line.
 
 use crate::bench::allan::{
-    against_definition, recovery, speed_record, Recovery, SAMPLES, SCENARIOS, SHORT, SPEED_TAU0_S,
-    TAU0_S,
+    against_definition, judge, recovery, speed_record, truth_present, Recovery, Scenario,
+    Selection, SAMPLES, SCENARIOS, SHORT, SPEED_TAU0_S, TAU0_S,
 };
 use crate::bench::discover_categories::{trials, TrialCounts};
 use crate::bench::discover_summary::{summarize, Summary};
@@ -16,8 +16,8 @@ use crate::cli::output::{print_json, progress_bar};
 use crate::data::csv_writer::CellFormat::{Exp, Fixed};
 use crate::data::run_file::{Column, RunWriter, Series};
 use crate::error::LabError;
-use crate::noise::analysis::analyse;
-use crate::noise::terms::{ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS};
+use crate::noise::analysis::{analyse, Allan};
+use crate::noise::terms::{to_units, ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS};
 use crate::sim::scale_factor_rig::RigParams;
 use clap::{Args, Subcommand};
 
@@ -258,6 +258,16 @@ fn print_families(j: &ScaleFactorBench) {
 pub struct AllanBenchArgs {
     #[arg(long, default_value_t = 100)]
     pub seeds: u64,
+    /// The first seed (seeds first..first + seeds): another set of seeds
+    /// checks that nothing was tuned to the default ones.
+    #[arg(long, default_value_t = 1)]
+    pub first_seed: u64,
+    /// Only the scenarios whose name contains this.
+    #[arg(long, default_value = "")]
+    pub only: String,
+    /// List each record where a present term's interval missed the truth.
+    #[arg(long)]
+    pub misses: bool,
     #[command(flatten)]
     pub json: Json,
 }
@@ -267,11 +277,26 @@ fn allan(a: &AllanBenchArgs) -> Result<(), LabError> {
         return Err(LabError::Usage(format!("--seeds {}: 1..=10000", a.seeds)));
     }
     let bar = progress_bar(
-        a.seeds * SCENARIOS.len() as u64,
+        a.seeds
+            * SCENARIOS
+                .iter()
+                .filter(|s| s.name.contains(a.only.as_str()))
+                .count() as u64,
         "{bar:40} {pos}/{len} records {eta}",
         a.json.json,
     );
-    let r = recovery(a.seeds, || bar.inc(1)).map_err(|e| LabError::Bench(e.to_string()))?;
+    let sel = Selection {
+        first_seed: a.first_seed,
+        seeds: a.seeds,
+        only: a.only.clone(),
+    };
+    let r = recovery(&sel, |sc, seed, an| {
+        if a.misses {
+            bar.suspend(|| print_misses(sc, seed, an));
+        }
+        bar.inc(1)
+    })
+    .map_err(|e| LabError::Bench(e.to_string()))?;
     bar.finish_and_clear();
     let n = a.seeds;
     if !a.json.json {
@@ -280,13 +305,74 @@ fn allan(a: &AllanBenchArgs) -> Result<(), LabError> {
     println!(
         "{}",
         serde_json::json!({
-            "seeds": n, "samples": SAMPLES, "tau0_s": TAU0_S,
+            "seeds": n, "first_seed": a.first_seed, "samples": SAMPLES, "tau0_s": TAU0_S,
             "terms": NAMES.iter().chain(&[SIN_NAME, MARKOV_NAME]).collect::<Vec<_>>(),
             "rows": r.rows, "recovered": r.recovered, "recovered_of": r.recovered_of,
             "false_reports": r.false_reports, "false_reports_of": r.false_reports_of
         })
     );
     Ok(())
+}
+
+/// One line per present term whose interval missed the truth.
+fn print_misses(sc: &Scenario, seed: u64, an: &Allan) {
+    let present = truth_present(&sc.truth);
+    let t = &sc.truth;
+    for (j, &(reported, held, _)) in judge(an, t).iter().enumerate() {
+        if !present[j] || held {
+            continue;
+        }
+        let tf = &an.terms;
+        let what = match j {
+            SIN => tf.sinusoid.map_or("not reported".into(), |s| {
+                let a = s.amplitude_dps;
+                let f = s.frequency_hz;
+                format!(
+                    "amplitude {:.3} [{:.3}, {:.3}] deg/h, f {:.6} [{:.6}, {:.6}] Hz",
+                    a.value * 3600.0,
+                    a.lo * 3600.0,
+                    a.hi * 3600.0,
+                    f.value,
+                    f.lo,
+                    f.hi
+                )
+            }),
+            MARKOV => tf.correlated.map_or("not reported".into(), |m| {
+                let (s, c) = (m.sigma_dph, m.tau_s);
+                format!(
+                    "sigma {:.4} [{:.4}, {:.4}] deg/h, T {:.2} [{:.2}, {:.2}] s",
+                    s.value, s.lo, s.hi, c.value, c.lo, c.hi
+                )
+            }),
+            j if reported => format!(
+                "{:.4} [{:.4}, {:.4}]",
+                to_units(j, tf.c[j]),
+                to_units(j, tf.lo[j]),
+                to_units(j, tf.hi[j])
+            ),
+            _ => "not reported".into(),
+        };
+        let truth = match j {
+            SIN => t
+                .sinusoid
+                .map_or(String::new(), |(a, f)| format!("{a} deg/h at {f} Hz")),
+            MARKOV => t
+                .markov
+                .map_or(String::new(), |(s, c)| format!("{s} deg/h, {c} s")),
+            j => format!("{}", t.laws[j]),
+        };
+        println!(
+            "miss: {} seed {seed} {}: truth {truth}; {what}; chi2/dof {:.2}{}",
+            sc.name,
+            SHORT[j],
+            tf.goodness.chi2_per_dof,
+            if tf.goodness.consistent {
+                ""
+            } else {
+                " (inconsistent)"
+            }
+        );
+    }
 }
 
 fn print_allan(r: &Recovery, n: u64) {
@@ -304,7 +390,10 @@ fn print_allan(r: &Recovery, n: u64) {
         print!(" {:>22}", format!("{} ({})", SHORT[j], unit(j)));
     }
     println!(" {:>10} {:>8}", "consistent", "filter");
-    for (row, sc) in r.rows.iter().zip(SCENARIOS) {
+    for row in &r.rows {
+        let Some(sc) = SCENARIOS.iter().find(|s| s.name == row.scenario) else {
+            continue;
+        };
         print!("{:<34}", row.scenario);
         let truth = |j: usize| match j {
             SIN => sc.truth.sinusoid.map_or(0.0, |s| s.0),

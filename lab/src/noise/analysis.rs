@@ -79,6 +79,12 @@ pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
     }
     let dph = |v: &[f64]| -> Vec<f64> { v.iter().map(|v| v.sqrt() * 3600.0).collect() };
     let readings = readings::read(&taus, &dph(&avar), &dph(&lo), &dph(&hi));
+    let mut terms = terms;
+    let floor_hi = taus
+        .iter()
+        .position(|&t| t == readings.floor_tau_s)
+        .map_or(f64::NAN, |i| hi[i].sqrt() * 3600.0);
+    bound_bias(&mut terms, &readings, floor_hi);
     let mean = y.iter().sum::<f64>() / n as f64;
     let mean_se = terms.model_at(n as f64 * tau0).sqrt();
     Ok(Allan {
@@ -94,6 +100,29 @@ pub fn analyse(y: &[f64], tau0: f64) -> Result<Allan, AllanError> {
         mean_dps: mean,
         mean_se_dps: mean_se,
     })
+}
+
+/// On a curve whose floor is not resolved the flicker's level cannot be
+/// read: the floor is only an upper bound on it (a longer record may show
+/// the curve going on down). A fitted B above floor/0.664 puts the model's
+/// flat part above the measured floor, which the curve contradicts: B's
+/// value is held to floor/0.664 and reported as an upper bound, and the
+/// top of its interval to what the floor point's own 95 % interval allows,
+/// `floor_hi_dph`/0.664 (the floor is the lowest of many scattered points,
+/// so the truth may lie above it).
+fn bound_bias(t: &mut TermFit, r: &Readings, floor_hi_dph: f64) {
+    const B: usize = 2;
+    if r.resolved || !t.present[B] || !r.bias_instability_dph.is_finite() {
+        return;
+    }
+    let bound = terms::from_units(B, r.bias_instability_dph);
+    t.bias_upper_bound = true;
+    t.c[B] = t.c[B].min(bound);
+    if floor_hi_dph.is_finite() {
+        t.hi[B] = t.hi[B].min(terms::from_units(B, floor_hi_dph / 0.664));
+    }
+    t.hi[B] = t.hi[B].max(t.c[B]);
+    t.lo[B] = t.lo[B].min(t.c[B]);
 }
 
 /// Why a record's sampling does not suit the Allan variance.

@@ -13,6 +13,7 @@ pub mod fit;
 pub mod gaps;
 pub mod model;
 pub mod nnls;
+pub mod profile;
 pub mod readings;
 pub mod terms;
 pub mod uncertainty;
