@@ -14,6 +14,32 @@ fn dir(name: &str) -> std::path::PathBuf {
     common::dir(&format!("discover-{name}"))
 }
 
+/// `gyro-lab discover --json` on `run` (against `model` if given), which
+/// must succeed; its standard output.
+fn discover_ok(
+    gyro: &str,
+    model: Option<&std::path::Path>,
+    run: &std::path::Path,
+    out: &std::path::Path,
+) -> String {
+    let p = |x: &std::path::Path| x.display().to_string();
+    let mut args = vec!["discover".to_string(), "--gyro".into(), gyro.into()];
+    if let Some(m) = model {
+        args.extend(["--model".into(), p(m)]);
+    }
+    args.extend([
+        "--data".into(),
+        p(run),
+        "--out".into(),
+        p(out),
+        "--json".into(),
+    ]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, stdout, err) = lab(&args);
+    assert_eq!(code, 0, "{err}");
+    stdout
+}
+
 #[test]
 fn vibration_rectification_from_the_closed_loop_simulation() {
     // The firmware's FOG core closed around the simulated interferometer,
@@ -38,17 +64,7 @@ fn vibration_rectification_from_the_closed_loop_simulation() {
         &p(&run),
     ]);
     assert_eq!(code, 0, "{err}");
-    let (code, out, err) = lab(&[
-        "discover",
-        "--gyro",
-        "fog",
-        "--data",
-        &p(&run),
-        "--out",
-        &p(&d.join("o")),
-        "--json",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let out = discover_ok("fog", None, &run, &d.join("o"));
     let v = json(&out);
     let found = v["found"].as_array().unwrap();
     assert_eq!(found.len(), 1, "{v}");
@@ -104,19 +120,7 @@ fn warm_up_from_the_chamber_simulation() {
         ),
     )
     .unwrap();
-    let (code, out, err) = lab(&[
-        "discover",
-        "--gyro",
-        "rlg",
-        "--model",
-        &p(&model),
-        "--data",
-        &p(&run),
-        "--out",
-        &p(&d.join("o")),
-        "--json",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let out = discover_ok("rlg", Some(&model), &run, &d.join("o"));
     let v = json(&out);
     let found = v["found"].as_array().unwrap();
     assert_eq!(found.len(), 1, "{v}");
@@ -218,17 +222,7 @@ fn outputs_and_the_model_written_back() {
     ]);
     assert_eq!(code, 0, "{err}");
     let out = d.join("o");
-    let (code, stdout, err) = lab(&[
-        "discover",
-        "--gyro",
-        "fog",
-        "--data",
-        &p(&run),
-        "--out",
-        &p(&out),
-        "--json",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let stdout = discover_ok("fog", None, &run, &out);
     let v = json(&stdout);
     for k in [
         "found",
@@ -263,19 +257,7 @@ fn outputs_and_the_model_written_back() {
     assert!(html.contains("time since power-on, s") && html.contains("averaging time tau, s"));
     assert!(html.contains("scale_factor_temperature contribution, deg/h"));
     // The model written back explains the run: nothing more is missing.
-    let (code, stdout, err) = lab(&[
-        "discover",
-        "--gyro",
-        "fog",
-        "--model",
-        &p(&out.join("model.toml")),
-        "--data",
-        &p(&run),
-        "--out",
-        &p(&d.join("o2")),
-        "--json",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let stdout = discover_ok("fog", Some(&out.join("model.toml")), &run, &d.join("o2"));
     let v2 = json(&stdout);
     assert!(v2["found"].as_array().unwrap().is_empty(), "{v2}");
     assert!(
@@ -339,17 +321,7 @@ fn bad_input_is_one_line_and_exit_2() {
         assert!(err.contains(what), "{err}");
     }
     // A library effect whose inputs the run lacks is skipped, and said so.
-    let (code, out, err) = lab(&[
-        "discover",
-        "--gyro",
-        "fog",
-        "--data",
-        &p(&run),
-        "--out",
-        &p(&d.join("o")),
-        "--json",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let out = discover_ok("fog", None, &run, &d.join("o"));
     let skipped: Vec<String> = json(&out)["skipped"]
         .as_array()
         .unwrap()
@@ -399,21 +371,10 @@ fn a_short_record_has_intervals_at_least_as_wide_as_white_noise_gives() {
     // the standard error a white-noise least-squares fit of the samples
     // gives (the noise that made the record is white).
     let d = dir("short");
-    let p = |x: &std::path::Path| x.display().to_string();
     for seed in 1..=4u64 {
         let run = d.join(format!("short{seed}.csv"));
         let (se_bias, se_sf) = short_table_run(&run, seed, 0.005);
-        let (code, out, err) = lab(&[
-            "discover",
-            "--gyro",
-            "fog",
-            "--data",
-            &p(&run),
-            "--out",
-            &p(&d.join(format!("o{seed}"))),
-            "--json",
-        ]);
-        assert_eq!(code, 0, "{err}");
+        let out = discover_ok("fog", None, &run, &d.join(format!("o{seed}")));
         let v = json(&out);
         assert_eq!(v["intervals_reliable"], false, "{v}");
         assert!(v["intervals_note"].as_str().unwrap().contains("unreliable"));
@@ -482,22 +443,11 @@ fn a_burst_that_swings_both_ways_is_unexplained_where_it_is() {
     // burst and nowhere else; the same record without it has nothing
     // unexplained.
     let d = dir("burst");
-    let p = |x: &std::path::Path| x.display().to_string();
     for seed in 1..=2u64 {
         for burst in [true, false] {
             let run = d.join(format!("rest{seed}{burst}.csv"));
             rest_run(&run, seed, burst);
-            let (code, out, err) = lab(&[
-                "discover",
-                "--gyro",
-                "fog",
-                "--data",
-                &p(&run),
-                "--out",
-                &p(&d.join(format!("o{seed}{burst}"))),
-                "--json",
-            ]);
-            assert_eq!(code, 0, "{err}");
+            let out = discover_ok("fog", None, &run, &d.join(format!("o{seed}{burst}")));
             let v = json(&out);
             let names: Vec<&str> = v["found"]
                 .as_array()

@@ -21,7 +21,7 @@
 use super::design::Design;
 use super::noise_model::{profile, NoiseModel};
 use super::select::{Selection, THRESHOLD};
-use super::terms::{Kind, Term};
+use super::terms::{without, Kind, Term};
 use crate::model::effects::Effect;
 
 /// Effects set aside at most (then the selection stands as it is).
@@ -36,12 +36,7 @@ pub const MAX_SET_ASIDE: usize = 3;
 /// a decaying warm-up is not a random walk that happened to fall.
 /// `full` is [`loglik`] of `terms`.
 pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel, full: f64) -> f64 {
-    let rest: Vec<Term> = terms
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| *i != j)
-        .map(|(_, t)| *t)
-        .collect();
+    let rest = without(terms, j);
     2.0 * (full - loglik(d, &rest, noise)) - terms[j].kind.dof() as f64 * d.n().max(2.0).ln()
 }
 

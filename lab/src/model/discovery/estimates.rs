@@ -12,7 +12,7 @@
 
 use super::design::{inflation, Design};
 use super::select::{columns, params_of};
-use super::terms::{Kind, Term};
+use super::terms::{without, Kind, Term};
 use crate::model::effects::Effect;
 use crate::numerics::lsq::wls;
 use crate::numerics::stats::t_975;
@@ -111,12 +111,7 @@ pub fn estimate(d: &Design, terms: &[Term]) -> Option<Final> {
             }
         }
         col += ncol;
-        let rest: Vec<Term> = terms
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| *i != j)
-            .map(|(_, t)| *t)
-            .collect();
+        let rest = without(terms, j);
         let delta_bic = c_full - d.criterion_of(&rest);
         let with_back: Vec<f64> = r_full.iter().zip(&parts[j]).map(|(a, b)| a + b).collect();
         let share = if ss0 > 0.0 {

@@ -21,7 +21,7 @@
 //! cheapest first (backward steps), never to return.
 
 use super::design::{Design, Fit};
-use super::terms::{Kind, Shape, Term};
+use super::terms::{without, Kind, Shape, Term};
 use super::transients::{cusum_peaks, step_peaks, white_sigma, MAX_STEPS};
 use crate::model::effects::Effect;
 use crate::model::ranges;
@@ -443,12 +443,7 @@ fn settled(d: &Design, mut terms: Vec<Term>) -> f64 {
         let c = d.criterion_of(&terms);
         let cheapest = (1..terms.len())
             .map(|j| {
-                let rest: Vec<Term> = terms
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, _)| *i != j)
-                    .map(|(_, t)| *t)
-                    .collect();
+                let rest = without(&terms, j);
                 (j, d.criterion_of(&rest) - c)
             })
             .min_by(|a, b| a.1.total_cmp(&b.1));

@@ -216,6 +216,16 @@ impl Term {
     }
 }
 
+/// `terms` without its `j`-th: the model a term's worth is judged against.
+pub fn without(terms: &[Term], j: usize) -> Vec<Term> {
+    terms
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != j)
+        .map(|(_, t)| *t)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
