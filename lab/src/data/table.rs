@@ -235,7 +235,6 @@ impl ColumnStream {
             .has_headers(false)
             .flexible(true)
             .comment(Some(b'#'))
-            .trim(csv::Trim::All)
             .buffer_capacity(1 << 20)
             .from_reader(std::io::BufReader::with_capacity(1 << 20, file));
         let mut rec = csv::ByteRecord::new();
@@ -249,7 +248,7 @@ impl ColumnStream {
         let header_line = rec.position().map_or(1, |p| p.line());
         let header: Vec<String> = rec
             .iter()
-            .map(|f| String::from_utf8_lossy(f).into_owned())
+            .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
             .collect();
         let mut fields = Vec::new();
         let mut cols: Vec<&str> = required.to_vec();
@@ -274,11 +273,13 @@ impl ColumnStream {
         let mut lines = Vec::new();
         while rdr.read_byte_record(&mut rec).map_err(at)? {
             let line = rec.position().map_or(0, |p| p.line());
-            if rec.iter().all(|f| f.is_empty()) {
+            // Cells are trimmed here, only those read: the reader's own
+            // trimming of every field cost a third of a long record's read.
+            if rec.iter().all(|f| f.trim_ascii().is_empty()) {
                 continue;
             }
             for (k, &f) in fields.iter().enumerate() {
-                let cell = rec.get(f - 1).unwrap_or(b"");
+                let cell = rec.get(f - 1).unwrap_or(b"").trim_ascii();
                 let text = std::str::from_utf8(cell).unwrap_or("");
                 let v = number(text)
                     .map_err(|m| LabError::at(path, line, column_ref(f, cols[k]), m.to_string()))?;
