@@ -24,6 +24,17 @@ impl Verdict {
         self
     }
 
+    /// A value shown as `shown`, tagged with the JSON key `key`.
+    fn tagged(&mut self, key: &str, shown: &str) -> &mut Self {
+        let _ = write!(
+            self.html,
+            "<span class=\"v\" data-key=\"{}\">{}</span>",
+            esc(key),
+            esc(shown)
+        );
+        self
+    }
+
     /// A number from the JSON key `key` (a path: `a.b`, `knees_c.0`),
     /// printed with `decimals` decimals.
     pub fn num(&mut self, key: &str, value: f64, decimals: usize) -> &mut Self {
@@ -32,34 +43,25 @@ impl Verdict {
         } else {
             "n/a".to_owned()
         };
-        let _ = write!(
-            self.html,
-            "<span class=\"v\" data-key=\"{}\">{}</span>",
-            esc(key),
-            esc(&shown)
-        );
-        self
+        self.tagged(key, &shown)
+    }
+
+    /// A pair from the JSON array `key` (`key.0 .. key.1`): a range or an
+    /// interval.
+    pub fn range(&mut self, key: &str, pair: [f64; 2], decimals: usize) -> &mut Self {
+        self.num(&format!("{key}.0"), pair[0], decimals)
+            .text(" .. ")
+            .num(&format!("{key}.1"), pair[1], decimals)
     }
 
     /// A word from the JSON key `key` (a string value).
     pub fn word(&mut self, key: &str, value: &str) -> &mut Self {
-        let _ = write!(
-            self.html,
-            "<span class=\"v\" data-key=\"{}\">{}</span>",
-            esc(key),
-            esc(value)
-        );
-        self
+        self.tagged(key, value)
     }
 
     /// A count from the JSON key `key`.
     pub fn count(&mut self, key: &str, value: usize) -> &mut Self {
-        let _ = write!(
-            self.html,
-            "<span class=\"v\" data-key=\"{}\">{value}</span>",
-            esc(key)
-        );
-        self
+        self.tagged(key, &value.to_string())
     }
 
     /// A warning sentence (its kind, as the JSON's `warnings` names it).

@@ -24,9 +24,7 @@ fn sf_verdict((coeffs, data): &(String, String), v: &Validation) -> Verdict {
     ))
     .count("table_nodes", v.table_nodes)
     .text(" nodes calibrated over ")
-    .num("calibrated_range_c.0", v.calibrated_range_c[0], 2)
-    .text(" .. ")
-    .num("calibrated_range_c.1", v.calibrated_range_c[1], 2)
+    .range("calibrated_range_c", v.calibrated_range_c, 2)
     .text(" degC, coil sensor lag ")
     .num("sensor_lag_s", v.sensor_lag_s, 1)
     .text(" s; ")
@@ -242,9 +240,7 @@ fn th_verdict((coeffs, data): &(String, String), s: &CompensateSummary) -> Verdi
     v.text(".");
     if let Some(range) = &s.calibrated_range {
         v.text(" The fit saw monoblock A ")
-            .num("calibrated_range.mono_a_c.0", range.mono_a_c[0], 1)
-            .text(" .. ")
-            .num("calibrated_range.mono_a_c.1", range.mono_a_c[1], 1)
+            .range("calibrated_range.mono_a_c", range.mono_a_c, 1)
             .text(" degC; ")
             .count("out_of_range_spans.length", s.out_of_range_spans.len())
             .text(" span(s) of this run lay outside it.");

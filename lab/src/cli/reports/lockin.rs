@@ -25,9 +25,7 @@ fn verdict(r: &LockIn) -> Verdict {
         .text(" photodiode channel(s): lock-in ")
         .num("lock_in_dps", r.lock_in_dps, 6)
         .text(" deg/s, 95 % interval ")
-        .num("lock_in_ci_dps.0", r.lock_in_ci_dps[0], 6)
-        .text(" .. ")
-        .num("lock_in_ci_dps.1", r.lock_in_ci_dps[1], 6)
+        .range("lock_in_ci_dps", r.lock_in_ci_dps, 6)
         .text(" deg/s, at an input rate of ")
         .num("input_rate_dps", r.input_rate_dps, 6)
         .text(&format!(

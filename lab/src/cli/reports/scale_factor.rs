@@ -49,9 +49,7 @@ fn verdict(f: &SfFit, plateaus: Option<&[Plateau]>) -> Verdict {
     .text(" rows over ")
     .num("duration_s", f.duration_s, 0)
     .text(" s, coil ")
-    .num("range_c.0", f.range_c[0], 2)
-    .text(" .. ")
-    .num("range_c.1", f.range_c[1], 2)
+    .range("range_c", f.range_c, 2)
     .text(" degC");
     if let Some(p) = plateaus {
         v.text(&format!(", {} plateaus", p.len()));
@@ -67,9 +65,7 @@ fn verdict(f: &SfFit, plateaus: Option<&[Plateau]>) -> Verdict {
         v.text(if i == 0 { ": at " } else { ", at " })
             .num(&format!("knees_c.{i}"), k.value, 2)
             .text(" degC (95 % interval ")
-            .num(&format!("knees_ci_c.{i}.0"), k.lo, 2)
-            .text(" .. ")
-            .num(&format!("knees_ci_c.{i}.1"), k.hi, 2)
+            .range(&format!("knees_ci_c.{i}"), [k.lo, k.hi], 2)
             .text(")");
     }
     let next = f
