@@ -6,7 +6,7 @@
 #![allow(clippy::needless_range_loop)] // per-term parallel arrays
 
 mod common;
-use common::lab;
+use common::{lab, lab_ok};
 
 use gyro_lab::bench::allan::{judge, truth_present, SAMPLES, SCENARIOS, SHORT, TAU0_S};
 use gyro_lab::noise::analysis::{analyse, Allan};
@@ -354,7 +354,7 @@ fn json_files_and_a_self_contained_report() {
         1.0,
     );
     let out = d.join("out");
-    let (code, stdout, err) = lab(&[
+    let stdout = lab_ok(&[
         "allan",
         "--data",
         run.to_str().unwrap(),
@@ -362,7 +362,6 @@ fn json_files_and_a_self_contained_report() {
         out.to_str().unwrap(),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
     let n = v["taus_s"].as_array().unwrap().len();
     assert!(n >= 30);
@@ -472,13 +471,12 @@ fn agrees_with_allantools() {
     // A record and allantools' overlapping deviations of it, produced
     // offline (lab/tests/data; allantools from PyPI): ours within 1e-9.
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
-    let (code, stdout, err) = lab(&[
+    let stdout = lab_ok(&[
         "allan",
         "--data",
         dir.join("white_rw.csv").to_str().unwrap(),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let ours: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
     let theirs: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("allantools_oadev.json")).unwrap())

@@ -3,7 +3,7 @@
 //! bench discover`'s), the files and JSON it promises, and bad input.
 
 mod common;
-use common::{json, lab};
+use common::{json, lab, lab_ok};
 
 use gyro_lab::bench::discover_trials::{draw, trial, Trial, TrialKind};
 use gyro_lab::model::effects::Effect;
@@ -35,9 +35,7 @@ fn discover_ok(
         "--json".into(),
     ]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (code, stdout, err) = lab(&args);
-    assert_eq!(code, 0, "{err}");
-    stdout
+    lab_ok(&args)
 }
 
 #[test]
@@ -48,7 +46,7 @@ fn vibration_rectification_from_the_closed_loop_simulation() {
     let d = dir("vib");
     let run = d.join("vib.csv");
     let p = |x: &std::path::Path| x.display().to_string();
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "fog",
         "--no-vibration-correction",
@@ -63,7 +61,6 @@ fn vibration_rectification_from_the_closed_loop_simulation() {
         "--out",
         &p(&run),
     ]);
-    assert_eq!(code, 0, "{err}");
     let out = discover_ok("fog", None, &run, &d.join("o"));
     let v = json(&out);
     let found = v["found"].as_array().unwrap();
@@ -91,7 +88,7 @@ fn warm_up_from_the_chamber_simulation() {
     let d = dir("chamber");
     let run = d.join("ch.csv");
     let p = |x: &std::path::Path| x.display().to_string();
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "chamber",
         "--profile",
@@ -99,7 +96,6 @@ fn warm_up_from_the_chamber_simulation() {
         "--out",
         &p(&run),
     ]);
-    assert_eq!(code, 0, "{err}");
     let t = gyro_sim::ChamberParams::default().truth;
     let model = d.join("model.toml");
     std::fs::write(
@@ -208,7 +204,7 @@ fn outputs_and_the_model_written_back() {
     )
     .unwrap();
     let run = d.join("run.csv");
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "run",
         "--model",
@@ -220,7 +216,6 @@ fn outputs_and_the_model_written_back() {
         "--out",
         &p(&run),
     ]);
-    assert_eq!(code, 0, "{err}");
     let out = d.join("o");
     let stdout = discover_ok("fog", None, &run, &out);
     let v = json(&stdout);

@@ -120,7 +120,7 @@ mod report_check;
 fn report_with_the_fit_and_the_bound() {
     let d = common::dir("lockin-report");
     let p = |n: &str| d.join(n).display().to_string();
-    let (code, _, err) = common::lab(&[
+    common::lab_ok(&[
         "simulate",
         "lockin",
         "--rate-dps",
@@ -133,8 +133,7 @@ fn report_with_the_fit_and_the_bound() {
         "--out",
         &p("f.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
-    let (code, out, err) = common::lab(&[
+    let out = common::lab_ok(&[
         "lockin",
         "--data",
         &p("f.csv"),
@@ -144,7 +143,6 @@ fn report_with_the_fit_and_the_bound() {
         &p("r"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&out);
     let html = std::fs::read_to_string(d.join("r").join("report.html")).unwrap();
     report_check::check(&html, &v, 3, 12);
@@ -168,7 +166,7 @@ fn report_with_the_fit_and_the_bound() {
     assert!((noise / 0.01 - 1.0).abs() < 0.05, "{noise}");
 
     // Omega_I/Omega_L = 100 from one channel: the bound is above 0.5 %.
-    let (code, _, err) = common::lab(&[
+    common::lab_ok(&[
         "simulate",
         "lockin",
         "--rate-dps",
@@ -180,8 +178,7 @@ fn report_with_the_fit_and_the_bound() {
         "--out",
         &p("g.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
-    let (code, out, err) = common::lab(&[
+    let out = common::lab_ok(&[
         "lockin",
         "--data",
         &p("g.csv"),
@@ -191,7 +188,6 @@ fn report_with_the_fit_and_the_bound() {
         &p("s"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&out);
     let html = std::fs::read_to_string(d.join("s").join("report.html")).unwrap();
     let kinds = report_check::assert_warnings_match(&html, &v);
@@ -223,7 +219,7 @@ fn report_with_the_fit_and_the_bound() {
         out_text.push('\n');
     }
     std::fs::write(d.join("tone.csv"), out_text).unwrap();
-    let (code, out, err) = common::lab(&[
+    let out = common::lab_ok(&[
         "lockin",
         "--data",
         &p("tone.csv"),
@@ -233,7 +229,6 @@ fn report_with_the_fit_and_the_bound() {
         &p("t"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&out);
     let html = std::fs::read_to_string(d.join("t").join("report.html")).unwrap();
     let kinds = report_check::assert_warnings_match(&html, &v);

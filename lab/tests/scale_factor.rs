@@ -4,7 +4,7 @@
 
 mod common;
 mod report_check;
-use common::lab;
+use common::{lab, lab_ok};
 
 use gyro_coeffs::fog_scale_factor::MAX_NODES;
 use gyro_lab::bench::scale_factor::{continuous_fit_test, multipoint_test, validation_test};
@@ -267,9 +267,8 @@ fn dir() -> std::path::PathBuf {
 fn command_line_round_trip() {
     let d = dir();
     let p = |n: &str| d.join(n).display().to_string();
-    let (code, _, err) = lab(&["simulate", "scale-factor", "--out", &p("fit.csv")]);
-    assert_eq!(code, 0, "{err}");
-    let (code, out, err) = lab(&[
+    lab_ok(&["simulate", "scale-factor", "--out", &p("fit.csv")]);
+    let out = lab_ok(&[
         "fit",
         "scale-factor",
         "--data",
@@ -278,7 +277,6 @@ fn command_line_round_trip() {
         &p("sf.toml"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
     for key in ["knees_c", "knees_ci_c", "residual_ppm", "segments"] {
         assert!(v.get(key).is_some(), "{key} missing: {v}");
@@ -298,7 +296,7 @@ fn command_line_round_trip() {
         gyro_coeffs::ScaleFactorTable::from_record(&t.to_record()),
         Ok(t)
     );
-    let (code, out, err) = lab(&[
+    let out = lab_ok(&[
         "compensate",
         "--coeffs",
         &p("sf.toml"),
@@ -308,7 +306,6 @@ fn command_line_round_trip() {
         &p("comp.csv"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
     assert!(v["comp_ppm"].as_f64().unwrap() < 1.0, "{v}");
     let text = std::fs::read_to_string(p("comp.csv")).unwrap();
@@ -423,7 +420,7 @@ fn fit_and_compensate_reports() {
     for (run, dir, figures) in [("fit.csv", "c", 6), ("mp.csv", "m", 3)] {
         std::fs::create_dir_all(d.join(dir)).unwrap();
         let out = d.join(dir).join("sf.toml").display().to_string();
-        let (code, stdout, err) = lab(&[
+        let stdout = lab_ok(&[
             "fit",
             "scale-factor",
             "--data",
@@ -432,7 +429,6 @@ fn fit_and_compensate_reports() {
             &out,
             "--json",
         ]);
-        assert_eq!(code, 0, "{err}");
         let v = common::json(&stdout);
         let report = d.join(dir).join("report.html");
         assert_eq!(
@@ -452,7 +448,7 @@ fn fit_and_compensate_reports() {
         }
     }
     // Compensation of another run with the continuous table.
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "scale-factor",
         "--quadratic-ppm-per-c2",
@@ -469,8 +465,7 @@ fn fit_and_compensate_reports() {
         "--out",
         &p("val.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
-    let (code, stdout, err) = lab(&[
+    let stdout = lab_ok(&[
         "compensate",
         "--coeffs",
         &p("c/sf.toml"),
@@ -480,7 +475,6 @@ fn fit_and_compensate_reports() {
         &p("val_comp.csv"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&stdout);
     assert!(v["comp_ppm"].as_f64().unwrap() < 1.0, "{v}");
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
@@ -503,7 +497,7 @@ fn fit_and_compensate_reports() {
 fn reports_warn_on_runs_built_to_trigger_it() {
     let d = common::dir("sf-warn");
     let p = |n: &str| d.join(n).display().to_string();
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "scale-factor",
         "--knees-c",
@@ -511,8 +505,7 @@ fn reports_warn_on_runs_built_to_trigger_it() {
         "--out",
         &p("edge.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
-    let (code, stdout, err) = lab(&[
+    let stdout = lab_ok(&[
         "fit",
         "scale-factor",
         "--data",
@@ -521,7 +514,6 @@ fn reports_warn_on_runs_built_to_trigger_it() {
         &p("edge.toml"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&stdout);
     let k = v["knees_c"][0].as_f64().unwrap();
     assert!((k - 56.0).abs() < 0.5, "{v}");
@@ -536,7 +528,7 @@ fn reports_warn_on_runs_built_to_trigger_it() {
          sf_ppm = [120.0, 165.0]\nbias_dph = [0.3, 0.3]\nsensor_lag_s = 30.0\n",
     )
     .unwrap();
-    let (code, _, err) = lab(&[
+    lab_ok(&[
         "simulate",
         "scale-factor",
         "--no-knee",
@@ -545,8 +537,7 @@ fn reports_warn_on_runs_built_to_trigger_it() {
         "--out",
         &p("val.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
-    let (code, stdout, err) = lab(&[
+    let stdout = lab_ok(&[
         "compensate",
         "--coeffs",
         &p("narrow.toml"),
@@ -556,7 +547,6 @@ fn reports_warn_on_runs_built_to_trigger_it() {
         &p("val_comp.csv"),
         "--json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v = common::json(&stdout);
     let spans = v["out_of_range_spans"].as_array().unwrap();
     assert!(!spans.is_empty(), "{v}");

@@ -2,21 +2,11 @@
 //! runs with different profiles and orientations, fit on one, compensate the
 //! other with the firmware's fixed-point code through `gyro-lab`.
 
-use std::process::Command;
+mod common;
 
 fn lab_json(args: &[&str]) -> serde_json::Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
-        .args(args)
-        .arg("--json")
-        .output()
-        .expect("run gyro-lab");
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
-    serde_json::from_str(text.lines().last().unwrap_or("{}")).expect("json")
+    let args: Vec<&str> = args.iter().copied().chain(["--json"]).collect();
+    common::json(&common::lab_ok(&args))
 }
 
 fn dir() -> std::path::PathBuf {
@@ -123,22 +113,21 @@ fn bad_coefficient_file() {
         format!("t_s,ref_rate_dps,rate_dps,t_mono_a_c,t_mono_b_c,t_case_c\n{rows}"),
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_gyro-lab"))
-        .args(["compensate", "--coeffs"])
-        .arg(&bad)
-        .arg("--data")
-        .arg(&run)
-        .arg("--out")
-        .arg(d.join("o.csv"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let p = |x: &std::path::Path| x.display().to_string();
+    let (code, _, err) = common::lab(&[
+        "compensate",
+        "--coeffs",
+        &p(&bad),
+        "--data",
+        &p(&run),
+        "--out",
+        &p(&d.join("o.csv")),
+    ]);
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains(&format!("{}:5:16", bad.display())), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
-mod common;
 mod report_check;
 
 /// `fit thermal` and `compensate` write report.html beside their output:

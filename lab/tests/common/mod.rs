@@ -18,6 +18,14 @@ pub fn lab(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Runs gyro-lab, which must succeed (else the test fails with its
+/// stderr): its stdout.
+pub fn lab_ok(args: &[&str]) -> String {
+    let (code, stdout, err) = lab(args);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    stdout
+}
+
 /// A scratch directory of this test process, `gyro-lab-<name>-<pid>`.
 pub fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("gyro-lab-{name}-{}", std::process::id()));
