@@ -184,6 +184,43 @@ fn two_pi_loop_converges_from_5_percent_vpi_error() {
     }
 }
 
+/// After acquisition the 2*pi loop shifts to its tracking gear (gain
+/// 1e-4, docs/fog.md "The 2*pi loop's gear") and still follows V_pi as it
+/// drifts: 2e-5 per second (a 1e-3/K modulator on a 1.2 K/min ramp). The
+/// tracking lag is the drift times the gear's time constant (1e4 closures
+/// over the resets' share of the error, about 0.5 s at 100 deg/s: lag
+/// 1.05e-5); the test allows 2.5e-5 (1.25 s). The output stays within
+/// 0.5 deg/h (1.4 ppm) of the truth.
+#[test]
+fn two_pi_loop_tracks_a_drifting_vpi_on_its_tracking_gear() {
+    for latency in [0, 1] {
+        let drift = 2e-5;
+        let mut r = rig(
+            with_latency(latency),
+            |o| o.vpi_drift_per_s = drift,
+            Profile::constant(100.0 * DEG),
+        );
+        mean_error(&mut r, 0, closures_in(1.0));
+        assert!(
+            r.fog.gain_loop_tracking(&r.cfg),
+            "latency {latency}: not on the tracking gear after 1 s in lock"
+        );
+        let m = mean_error(&mut r, closures_in(1.0), closures_in(6.0));
+        let cpt = m.last.codes_per_turn_q8 as f64 / 256.0;
+        let expected = 49_152.0 / (1.0 + drift * 6.0);
+        assert!(
+            (cpt / expected - 1.0).abs() < 2.5e-5,
+            "latency {latency}: codes per turn {cpt}, expected {expected} ({:.2e} off)",
+            cpt / expected - 1.0
+        );
+        assert!(
+            m.corrected_dph.abs() < 0.5,
+            "latency {latency}: {} deg/h while V_pi drifts (codes per turn {cpt})",
+            m.corrected_dph
+        );
+    }
+}
+
 #[test]
 fn power_loss_flags_then_recovers() {
     let mut r = rig(FogParams::default(), |_| {}, Profile::constant(30.0 * DEG));

@@ -142,8 +142,8 @@ proptest! {
         let mut dac = [0u16; 16];
         for _ in 0..3 {
             let out = fog.process(&cfg, &adc, over_range, &mut dac);
-            prop_assert!(out.codes_per_turn_q8 >= cfg.gain_loop.min_q8 && out.codes_per_turn_q8 <= cfg.gain_loop.max_q8);
-            prop_assert!(dac.iter().all(|&d| u32::from(d) <= cfg.gain_loop.max_q8 >> 8));
+            prop_assert!(out.codes_per_turn_q8 >= (cfg.gain_loop.min_q15 >> 7) as u32 && out.codes_per_turn_q8 <= (cfg.gain_loop.max_q15 >> 7) as u32);
+            prop_assert!(dac.iter().all(|&d| u32::from(d) <= (cfg.gain_loop.max_q15 >> 15) as u32));
             if adc.len() < cfg.n_samples || over_range {
                 prop_assert!(out.faults.contains(gyro_sp::fog::Faults::ADC_SATURATION));
             }

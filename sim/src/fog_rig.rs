@@ -132,6 +132,10 @@ where
     /// Completes a closure run as `simulate_optics` + `process_core`.
     pub fn finish_step(&mut self, out: ClosureOutput, true_rate: F) -> RigClosure<F> {
         self.closure_index += 1;
+        // The slow side, as the board's frame path runs it (there once per
+        // frame; the gear's acquisition time is 0.25 s, so the rig's every
+        // closure behaves the same).
+        self.fog.supervise(&self.cfg, 1);
         if self.cfg.params.dac_latency != 0 {
             self.dac.swap(0, 1);
         }

@@ -421,6 +421,8 @@ mod app {
             c.out.lost(0, Faults::CLOSURE_OVERRUN);
         }
         if c.out.frame_ends() {
+            // The loop's slow side (the 2*pi loop's gear), once per frame.
+            c.fog.supervise(&c.cfg, CLOSURES_PER_FRAME as u32);
             // The RLG words since the last frame.
             while let Some(w) = c.rlg_words.dequeue() {
                 c.out.set_rlg(w);

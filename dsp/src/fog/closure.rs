@@ -326,6 +326,24 @@ impl FogLoop {
         }
     }
 
+    /// The slow side, outside the closure (the board calls it once per
+    /// frame; `closures` closures ran since the last call): shifts the 2*pi
+    /// loop to its tracking gain after it has been in lock long enough, and
+    /// back to acquisition on a fault (gain_loop.rs). Judged on the last
+    /// closure's faults: a lock loss lasts many closures, and a fault the
+    /// call misses only delays nothing.
+    pub fn supervise(&mut self, cfg: &FogConfig, closures: u32) {
+        let healthy = !self
+            .faults
+            .intersects(Faults::OUT_OF_LOCK | Faults::OPTICAL_POWER_LOW | Faults::ADC_SATURATION);
+        self.gain_loop.supervise(&cfg.gain_loop, closures, healthy);
+    }
+
+    /// True once the 2*pi loop runs on its tracking gain.
+    pub fn gain_loop_tracking(&self, cfg: &FogConfig) -> bool {
+        self.gain_loop.tracking(&cfg.gain_loop)
+    }
+
     /// Current feedback phase, phase LSB, unwrapped.
     pub fn feedback(&self) -> i64 {
         self.feedback

@@ -4,7 +4,7 @@
 
 use super::agc::AgcConfig;
 use super::dither::DitherConfig;
-use super::gain_loop::GainLoopConfig;
+use super::gain_loop::{GainLoopConfig, GainLoopGears};
 use super::layout::{Kernel, MAX_HALF, MAX_SAMPLES_PER_HALF};
 use super::lock::LockConfig;
 use super::vibration::VibrationConfig;
@@ -43,8 +43,16 @@ pub struct FogParams {
     /// DMA ping-pong (the interrupt writes the buffer half the DMA has just
     /// left, applied the closure after next). At most 1.
     pub dac_latency: u32,
-    /// 2*pi gain-loop gain: fraction of a measured gain error corrected per reset.
+    /// 2*pi gain-loop gain while it acquires: fraction of a measured gain
+    /// error corrected per reset.
     pub gain_loop_gain: f64,
+    /// Its gain once acquired (the gear shift, gain_loop.rs): V_pi then only
+    /// drifts with temperature, and a fast loop's fluctuations follow a
+    /// vibration's resets and rectify (docs/fog.md, "The 2*pi loop's gear").
+    pub gain_loop_track_gain: f64,
+    /// Time in lock (no fault) before the 2*pi loop shifts to the tracking
+    /// gain, s.
+    pub gain_loop_acquire_s: f64,
     /// DAC codes that give 2*pi at the modulator at nominal V_pi.
     pub dac_codes_per_turn: u32,
     /// Depth dither, half width in ADC codes of the half-period level at the
@@ -89,6 +97,8 @@ impl Default for FogParams {
             loop_gain: 1.0,
             dac_latency: 0,
             gain_loop_gain: 0.05,
+            gain_loop_track_gain: 0.0001,
+            gain_loop_acquire_s: 0.25,
             dac_codes_per_turn: 49_152,
             dither_adc_codes: 60.0,
             adc_bits: 12,
@@ -114,7 +124,8 @@ pub enum ConfigError {
     /// phi0 outside [0.1, pi - 0.1] rad.
     Phi0,
     /// Loop gain outside (0, 2) (the one-closure integrator is unstable beyond),
-    /// or DAC latency above one closure.
+    /// a 2*pi loop gain outside [0, 1) or its acquisition time outside [0 s,
+    /// 1 h), or DAC latency above one closure.
     LoopGain,
     /// DAC codes per turn leave no headroom for the 2*pi loop in 16 bits.
     DacRange,
@@ -200,6 +211,10 @@ impl FogConfig {
             && p.loop_gain < 2.0
             && p.gain_loop_gain >= 0.0
             && p.gain_loop_gain < 1.0
+            && p.gain_loop_track_gain >= 0.0
+            && p.gain_loop_track_gain < 1.0
+            && p.gain_loop_acquire_s >= 0.0
+            && p.gain_loop_acquire_s < 3600.0
             && p.dac_latency <= 1)
         {
             return Err(ConfigError::LoopGain);
@@ -226,8 +241,16 @@ impl FogConfig {
             dither.mean_square(),
         )
         .ok_or(ConfigError::VibrationCoeff)?;
-        let gain_loop =
-            GainLoopConfig::new(p.gain_loop_gain, p.dac_codes_per_turn, p.phi0_rad, n_half);
+        let gain_loop = GainLoopConfig::new(
+            GainLoopGears {
+                acquire: p.gain_loop_gain,
+                track: p.gain_loop_track_gain,
+                acquire_closures: (p.gain_loop_acquire_s * p.closure_hz).ceil() as u32,
+            },
+            p.dac_codes_per_turn,
+            p.phi0_rad,
+            n_half,
+        );
 
         // Residual per normalised demodulator count. With depth phi0 + r (the
         // dither) the error slope is A*sin(phi0 + r), which the closure scales

@@ -5,6 +5,16 @@
 //! With the half period's residual estimate `d_j = -sign_j*(h_j - H)*cot(phi0/2)/H`,
 //! `sum_j w_j*sign_j*(h_j - H)` over the reset half periods is proportional to +g;
 //! integrating it against the digital gain (codes per turn) keeps a reset exactly 2*pi.
+//!
+//! Two gears: a fast gain acquires V_pi after start or a fault, a slow one
+//! tracks it once the loop has been in lock for a while. The fast loop's
+//! equilibrium fluctuates with the resets, and under a low-amplitude
+//! vibration the resets follow the vibration's phase, so its fluctuations
+//! rectify into a drift of about one output LSB (docs/fog.md, "The 2*pi
+//! loop's gear"); V_pi itself only drifts with temperature. The gear is
+//! chosen outside the closure ([`GainLoop::supervise`], once per frame on
+//! the board): the closure reads the gain in use from the state, as before
+//! from the configuration, so the shift costs it nothing.
 
 use super::demod::DemodSums;
 use super::modulator::Resets;
@@ -14,18 +24,33 @@ use core::f64::consts::TAU;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
 
-/// The 2*pi loop's gain, the digital gain's range and when it holds.
+/// The 2*pi loop's two gains (fraction of a measured gain error corrected
+/// per reset) and the closures in lock after which it shifts from the first
+/// to the second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainLoopGears {
+    pub acquire: f64,
+    pub track: f64,
+    pub acquire_closures: u32,
+}
+
+/// The 2*pi loop's gains, the digital gain's range and when it holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GainLoopConfig {
-    /// DAC Q8 codes-per-turn per unit normalised reset error (sum c_j*h_j /
-    /// H), divided by n_half (the estimate comes n times larger), Q4; below
-    /// 2^27.
+    /// Acquisition gain: DAC Q8 codes-per-turn per unit normalised reset
+    /// error (sum c_j*h_j / H), divided by n_half (the estimate comes n
+    /// times larger), Q4; below 2^20 (clamped: only depths near 0 or pi
+    /// with few half periods reach it, and then acquire more slowly).
     pub gain: i32,
+    /// Tracking gain, the same units.
+    pub track_gain: i32,
+    /// Closures in lock before the shift to `track_gain`.
+    pub acquire_closures: u32,
     /// Nominal DAC codes per turn, and the clamp of the digital gain
-    /// (-20 %, +25 %), Q8.
-    pub nominal_q8: u32,
-    pub min_q8: u32,
-    pub max_q8: u32,
+    /// (-20 %, +25 %), Q15 (below 2^31: at most 65 535 codes, config).
+    pub nominal_q15: i32,
+    pub min_q15: i32,
+    pub max_q15: i32,
     /// Residual beyond which the loop holds (0.1 rad), phase LSB: under
     /// strong dynamics a closure's DC carries the residual's delta^2, far
     /// more than a reset's 2*pi error, and V_pi drifts slowly anyway.
@@ -33,18 +58,25 @@ pub struct GainLoopConfig {
 }
 
 impl GainLoopConfig {
-    /// `loop_gain` of a measured gain error corrected per reset, at the
-    /// error's scale cot(phi0/2)/(2*pi) per unit, for `n_half` half periods,
-    /// around `dac_codes_per_turn` (2*pi at nominal V_pi).
-    pub fn new(loop_gain: f64, dac_codes_per_turn: u32, phi0_rad: f64, n_half: usize) -> Self {
+    /// The `gears`' fractions of a measured gain error corrected per reset,
+    /// at the error's scale cot(phi0/2)/(2*pi) per unit, for `n_half` half
+    /// periods, around `dac_codes_per_turn` (2*pi at nominal V_pi).
+    pub fn new(
+        gears: GainLoopGears,
+        dac_codes_per_turn: u32,
+        phi0_rad: f64,
+        n_half: usize,
+    ) -> Self {
         let cot_half = 1.0 / (phi0_rad / 2.0).tan();
-        let gain =
-            loop_gain * dac_codes_per_turn as f64 * 256.0 * cot_half / TAU * 16.0 / n_half as f64;
+        let per_unit = dac_codes_per_turn as f64 * 256.0 * cot_half / TAU * 16.0 / n_half as f64;
+        let q4 = |g: f64| (g * per_unit).round().clamp(0.0, ((1 << 20) - 1) as f64) as i32;
         Self {
-            gain: gain.round().clamp(0.0, ((1 << 27) - 1) as f64) as i32,
-            nominal_q8: dac_codes_per_turn << 8,
-            min_q8: ((dac_codes_per_turn as f64 * 0.8) * 256.0) as u32,
-            max_q8: ((dac_codes_per_turn as f64 * 1.25) * 256.0) as u32,
+            gain: q4(gears.acquire),
+            track_gain: q4(gears.track),
+            acquire_closures: gears.acquire_closures,
+            nominal_q15: (dac_codes_per_turn.min(65_535) << 15) as i32,
+            min_q15: ((dac_codes_per_turn as f64 * 0.8).min(65_535.0) * 32_768.0) as i32,
+            max_q15: ((dac_codes_per_turn as f64 * 1.25).min(65_535.0) * 32_768.0) as i32,
             hold_limit: phase_from_rad(HOLD_LIMIT_RAD),
         }
     }
@@ -53,23 +85,54 @@ impl GainLoopConfig {
 /// Residual beyond which the loop holds, rad.
 pub const HOLD_LIMIT_RAD: f64 = 0.1;
 
-/// State: the digital gain, DAC codes per turn in Q8.
+/// State: the digital gain, DAC codes per turn in Q15 (the modulator
+/// takes Q8; the finer integrator keeps the slow gear's updates, which in
+/// Q8 would round to nothing below about 5e-5 of V_pi without noise), and
+/// the gear.
 #[derive(Clone, Copy, Debug)]
 pub struct GainLoop {
-    codes_per_turn_q8: u32,
+    codes_per_turn_q15: i32,
+    /// The gain in use, [`GainLoopConfig::gain`]'s units.
+    gain: i32,
+    /// Closures in lock so far (saturating), up to the shift.
+    in_lock: u32,
 }
 
 impl GainLoop {
     pub fn new(cfg: &GainLoopConfig) -> Self {
         Self {
-            codes_per_turn_q8: cfg.nominal_q8,
+            codes_per_turn_q15: cfg.nominal_q15,
+            gain: cfg.gain,
+            in_lock: 0,
         }
+    }
+
+    /// The gear, from outside the closure: `closures` more closures have
+    /// run, `healthy` if the last was in lock with light and true levels.
+    /// A fault goes back to the acquisition gain and restarts the count;
+    /// after `cfg.acquire_closures` healthy ones the tracking gain is used.
+    pub fn supervise(&mut self, cfg: &GainLoopConfig, closures: u32, healthy: bool) {
+        self.in_lock = if healthy {
+            self.in_lock.saturating_add(closures)
+        } else {
+            0
+        };
+        self.gain = if self.in_lock >= cfg.acquire_closures {
+            cfg.track_gain
+        } else {
+            cfg.gain
+        };
+    }
+
+    /// True once the loop runs on its tracking gain.
+    pub fn tracking(&self, cfg: &GainLoopConfig) -> bool {
+        self.in_lock >= cfg.acquire_closures
     }
 
     /// The digital gain in use, DAC codes per turn, Q8.
     #[inline(always)]
     pub fn codes_per_turn_q8(&self) -> u32 {
-        self.codes_per_turn_q8
+        (self.codes_per_turn_q15 >> 7) as u32
     }
 
     /// One closure with true levels: its demodulated sums, the resets of
@@ -88,9 +151,9 @@ impl GainLoop {
     ) -> u32 {
         if residual.unsigned_abs() <= cfg.hold_limit {
             let err = reset_error(sums, resets, n_half);
-            self.codes_per_turn_q8 = trim(self.codes_per_turn_q8, err, cfg, recip_h);
+            self.trim(err, cfg, recip_h);
         }
-        self.codes_per_turn_q8
+        self.codes_per_turn_q8()
     }
 }
 
@@ -223,28 +286,38 @@ static BYTE_MOMENT: [u16; 256] = {
     t
 };
 
-/// New digital gain (DAC codes per turn, Q8) after one closure's reset
-/// error. `err`: [`reset_error`], n x ADC LSB; `cfg.gain`: Q8 codes per unit
-/// normalised error (err/(n*H)), Q4 (config folds the 1/n in), below 2^27;
-/// `recip_h`: 2^32 / H (H = DC of one half period's kept samples, at least
-/// 2, so below 2^31).
-#[inline(always)]
-fn trim(codes_per_turn_q8: u32, err: i32, cfg: &GainLoopConfig, recip_h: u32) -> u32 {
-    // err/H in Q20, saturated at |err/H| < 2^8 (n/16 times a 25 % gain error,
-    // the clamp's end): only a wild start converges slower.
-    let e_q20 = shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
-    // Q20 x Q4 gain >> 24 = Q8 codes, rounded; |delta| < 2^31.
-    let delta = ((e_q20 * cfg.gain as i64 + (1 << 23)) >> 24) as i32;
-    // The gain, min, max < 2^24 (config); the subtraction saturates.
-    (codes_per_turn_q8 as i32)
-        .saturating_sub(delta)
-        .max(cfg.min_q8 as i32)
-        .min(cfg.max_q8 as i32) as u32
+impl GainLoop {
+    /// New digital gain (DAC codes per turn, Q15) after one closure's reset
+    /// error. `err`: [`reset_error`], n x ADC LSB; the gear's gain: Q8 codes
+    /// per unit normalised error (err/(n*H)), Q4 (config folds the 1/n in),
+    /// below 2^20; `recip_h`: 2^32 / H (H = DC of one half period's kept
+    /// samples, at least 2, so below 2^31).
+    #[inline(always)]
+    fn trim(&mut self, err: i32, cfg: &GainLoopConfig, recip_h: u32) {
+        // err/H in Q20, saturated at |err/H| < 2^8 (n/16 times a 25 % gain
+        // error, the clamp's end): only a wild start converges slower.
+        let e_q20 = shr_saturate::<12, 29>(err as i64 * (recip_h as i32) as i64) as i64;
+        // Q20 x Q4 gain = Q8 codes in Q24, >> 17 = Q15 codes, rounded;
+        // |product| < 2^28 * 2^20, so |delta| < 2^31.
+        let delta = ((e_q20 * self.gain as i64 + (1 << 16)) >> 17) as i32;
+        // The gain, min, max < 2^31 (config); the subtraction saturates.
+        self.codes_per_turn_q15 = self
+            .codes_per_turn_q15
+            .saturating_sub(delta)
+            .max(cfg.min_q15)
+            .min(cfg.max_q15);
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const GEARS: GainLoopGears = GainLoopGears {
+        acquire: 0.05,
+        track: 0.0001,
+        acquire_closures: 3_125,
+    };
 
     /// The table-based count and index moment of carry masks against the plain
     /// bit loop, every 8- and 16-bit mask; bits above the closure's pairs ignored.
@@ -272,7 +345,7 @@ mod tests {
     /// inside it a large error drives it to the clamp and no further.
     #[test]
     fn holds_under_dynamics_and_saturates_at_the_clamp() {
-        let cfg = GainLoopConfig::new(0.05, 49_152, 0.75 * core::f64::consts::PI, 16);
+        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
         let resets = Resets {
             plus: 0xFF,
             minus: 0,
@@ -289,18 +362,85 @@ mod tests {
         let mut g = GainLoop::new(&cfg);
         let beyond = cfg.hold_limit as i32 + 1;
         for _ in 0..1000 {
-            assert_eq!(
-                g.update(&cfg, &sums, &resets, 16, beyond, recip_h),
-                cfg.nominal_q8
-            );
+            g.update(&cfg, &sums, &resets, 16, beyond, recip_h);
+            assert_eq!(g.codes_per_turn_q15, cfg.nominal_q15);
         }
         let err = reset_error(&sums, &resets, 16);
         assert_ne!(err, 0);
-        let mut last = cfg.nominal_q8;
         for _ in 0..100_000 {
-            last = g.update(&cfg, &sums, &resets, 16, 0, recip_h);
-            assert!((cfg.min_q8..=cfg.max_q8).contains(&last));
+            g.update(&cfg, &sums, &resets, 16, 0, recip_h);
+            assert!((cfg.min_q15..=cfg.max_q15).contains(&g.codes_per_turn_q15));
         }
-        assert!(last == cfg.min_q8 || last == cfg.max_q8, "{last}");
+        let last = g.codes_per_turn_q15;
+        assert!(last == cfg.min_q15 || last == cfg.max_q15, "{last}");
+        assert_eq!(g.codes_per_turn_q8(), (last >> 7) as u32);
+    }
+
+    /// The gear: the acquisition gain until `acquire_closures` healthy
+    /// closures, then the tracking gain (one step of the same error moves
+    /// the digital gain by their ratio, 1/500); a fault goes back.
+    #[test]
+    fn shifts_to_tracking_after_lock_and_back_on_a_fault() {
+        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
+        assert!((cfg.gain - 500 * cfg.track_gain).abs() <= 500);
+        let resets = Resets {
+            plus: 0xFF,
+            minus: 0,
+            plus_negative: false,
+            minus_negative: false,
+        };
+        let sums = DemodSums {
+            first: 0,
+            second: 0,
+            dc: 16 * 30_000,
+            carried: 8 * 30_100,
+        };
+        let recip_h = u32::MAX / 30_000;
+        let step = |g: &mut GainLoop| {
+            let before = g.codes_per_turn_q15 as i64;
+            g.update(&cfg, &sums, &resets, 16, 0, recip_h);
+            let after = g.codes_per_turn_q15 as i64;
+            g.codes_per_turn_q15 = before as i32;
+            after - before
+        };
+        let mut g = GainLoop::new(&cfg);
+        let fast = step(&mut g);
+        assert!(fast.abs() > 1000, "{fast}");
+        g.supervise(&cfg, cfg.acquire_closures - 1, true);
+        assert!(!g.tracking(&cfg));
+        assert!((step(&mut g) - fast).abs() <= 1);
+        g.supervise(&cfg, 1, true);
+        assert!(g.tracking(&cfg));
+        let slow = step(&mut g);
+        assert!((slow * 500 - fast).abs() <= 1000, "{slow} vs {fast}");
+        g.supervise(&cfg, u32::MAX, true);
+        assert!(g.tracking(&cfg));
+        g.supervise(&cfg, 25, false);
+        assert!(!g.tracking(&cfg));
+        assert!((step(&mut g) - fast).abs() <= 1);
+    }
+
+    /// Updates smaller than the modulator's Q8 step add up in the Q15
+    /// integrator: 1 000 closures of an error worth a tenth of a Q8 step
+    /// each move the modulator's gain by 100 steps (rounding each in Q8
+    /// would move it by none).
+    #[test]
+    fn sub_step_updates_accumulate() {
+        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
+        let mut g = GainLoop::new(&cfg);
+        g.supervise(&cfg, u32::MAX, true);
+        let start = g.codes_per_turn_q8() as i64;
+        // err * recip_h >> 12 = e_q20; e_q20 * gain = 2^24 / 10 (Q8 in Q24).
+        let recip_h = 1u32 << 12;
+        let e_q20 = ((1u64 << 24) / 10) / g.gain as u64;
+        for _ in 0..1_000 {
+            g.trim(e_q20 as i32, &cfg, recip_h);
+        }
+        let want = 1_000.0 * (e_q20 * g.gain as u64) as f64 / (1u64 << 24) as f64;
+        let moved = start - g.codes_per_turn_q8() as i64;
+        assert!(
+            (moved as f64 - want).abs() <= 0.04 * want,
+            "{moved} vs {want}"
+        );
     }
 }
