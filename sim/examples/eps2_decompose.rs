@@ -64,10 +64,12 @@ fn main() {
         eprintln!("configuration refused");
         return;
     };
+    // The bench's instrument carries detector noise; the rebuild needs the
+    // optics deterministic, so it is off here unless asked for.
     let sigma = arg("--adc-noise", 0.0);
+    let op = &mut rig.optics.p;
+    op.noise = sigma > 0.0;
     if sigma > 0.0 {
-        let op = &mut rig.optics.p;
-        op.noise = true;
         op.rin = 0.0;
         op.shot = sigma / op.operating_light(phi0).sqrt();
     }
