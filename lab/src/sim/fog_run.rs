@@ -36,7 +36,10 @@ pub struct FogRunParams {
     pub noise: bool,
     pub seed: u64,
     pub loop_gain: f64,
+    /// 2*pi loop's acquisition and tracking gains (docs/fog.md, "The 2*pi
+    /// loop's gear").
     pub gain_loop_gain: f64,
+    pub gain_loop_track_gain: f64,
     /// Modulator gain error, relative.
     pub vpi_error: f64,
     pub adc_bits: u32,
@@ -199,6 +202,7 @@ impl FogRun {
             closure_hz: p.closure_hz,
             loop_gain: p.loop_gain,
             gain_loop_gain: p.gain_loop_gain,
+            gain_loop_track_gain: p.gain_loop_track_gain,
             dither_adc_codes: p.dither_codes,
             vibration_correction: p.vibration_correction,
             dac_latency: p.dac_latency,

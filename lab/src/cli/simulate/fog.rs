@@ -49,9 +49,13 @@ pub struct FogArgs {
     /// Main-loop gain (fraction of the residual corrected per step).
     #[arg(long, default_value_t = 1.0)]
     pub loop_gain: f64,
-    /// 2*pi gain-loop gain (0 holds the digital gain at nominal).
+    /// 2*pi gain-loop gain while it acquires (0, with
+    /// --gain-loop-track-gain 0, holds the digital gain at nominal).
     #[arg(long, default_value_t = 0.05)]
     pub gain_loop_gain: f64,
+    /// 2*pi gain-loop gain once in lock for 0.25 s (the gear shift).
+    #[arg(long, default_value_t = 1e-4)]
+    pub gain_loop_track_gain: f64,
     /// Modulator gain error (V_pi off nominal), relative.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub vpi_error: f64,
@@ -92,6 +96,7 @@ impl FogArgs {
             seed: self.seed.seed,
             loop_gain: self.loop_gain,
             gain_loop_gain: self.gain_loop_gain,
+            gain_loop_track_gain: self.gain_loop_track_gain,
             vpi_error: self.vpi_error,
             adc_bits: self.adc_bits,
             dither_codes: self.dither_codes,
