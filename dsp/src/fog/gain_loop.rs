@@ -313,11 +313,35 @@ impl GainLoop {
 mod tests {
     use super::*;
 
-    const GEARS: GainLoopGears = GainLoopGears {
-        acquire: 0.05,
-        track: 0.0001,
-        acquire_closures: 3_125,
-    };
+    /// The reference instrument's loop: 3pi/4, 16 half periods, the
+    /// default gears.
+    fn reference_config() -> GainLoopConfig {
+        let gears = GainLoopGears {
+            acquire: 0.05,
+            track: 0.0001,
+            acquire_closures: 3_125,
+        };
+        GainLoopConfig::new(gears, 49_152, 0.75 * core::f64::consts::PI, 16)
+    }
+
+    /// A closure whose eight plus half periods all reset upward, at a DC of
+    /// 30 000 per half period, those half periods at `reset_level`: its
+    /// resets, sums and 2^32/H.
+    fn upward_resets(reset_level: i32) -> (Resets, DemodSums, u32) {
+        let resets = Resets {
+            plus: 0xFF,
+            minus: 0,
+            plus_negative: false,
+            minus_negative: false,
+        };
+        let sums = DemodSums {
+            first: 0,
+            second: 0,
+            dc: 16 * 30_000,
+            carried: 8 * reset_level,
+        };
+        (resets, sums, u32::MAX / 30_000)
+    }
 
     /// The table-based count and index moment of carry masks against the plain
     /// bit loop, every 8- and 16-bit mask; bits above the closure's pairs ignored.
@@ -345,20 +369,8 @@ mod tests {
     /// inside it a large error drives it to the clamp and no further.
     #[test]
     fn holds_under_dynamics_and_saturates_at_the_clamp() {
-        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
-        let resets = Resets {
-            plus: 0xFF,
-            minus: 0,
-            plus_negative: false,
-            minus_negative: false,
-        };
-        let sums = DemodSums {
-            first: 0,
-            second: 0,
-            dc: 16 * 30_000,
-            carried: 8 * 31_000,
-        };
-        let recip_h = u32::MAX / 30_000;
+        let cfg = reference_config();
+        let (resets, sums, recip_h) = upward_resets(31_000);
         let mut g = GainLoop::new(&cfg);
         let beyond = cfg.hold_limit as i32 + 1;
         for _ in 0..1000 {
@@ -381,21 +393,9 @@ mod tests {
     /// the digital gain by their ratio, 1/500); a fault goes back.
     #[test]
     fn shifts_to_tracking_after_lock_and_back_on_a_fault() {
-        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
+        let cfg = reference_config();
         assert!((cfg.gain - 500 * cfg.track_gain).abs() <= 500);
-        let resets = Resets {
-            plus: 0xFF,
-            minus: 0,
-            plus_negative: false,
-            minus_negative: false,
-        };
-        let sums = DemodSums {
-            first: 0,
-            second: 0,
-            dc: 16 * 30_000,
-            carried: 8 * 30_100,
-        };
-        let recip_h = u32::MAX / 30_000;
+        let (resets, sums, recip_h) = upward_resets(30_100);
         let step = |g: &mut GainLoop| {
             let before = g.codes_per_turn_q15 as i64;
             g.update(&cfg, &sums, &resets, 16, 0, recip_h);
@@ -426,7 +426,7 @@ mod tests {
     /// would move it by none).
     #[test]
     fn sub_step_updates_accumulate() {
-        let cfg = GainLoopConfig::new(GEARS, 49_152, 0.75 * core::f64::consts::PI, 16);
+        let cfg = reference_config();
         let mut g = GainLoop::new(&cfg);
         g.supervise(&cfg, u32::MAX, true);
         let start = g.codes_per_turn_q8() as i64;
