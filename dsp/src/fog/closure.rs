@@ -330,8 +330,8 @@ impl FogLoop {
     /// frame; `closures` closures ran since the last call): shifts the 2*pi
     /// loop to its tracking gain after it has been in lock long enough, and
     /// back to acquisition on a fault (gain_loop.rs). Judged on the last
-    /// closure's faults: a lock loss lasts many closures, and a fault the
-    /// call misses only delays nothing.
+    /// closure's faults: a lock loss lasts many closures; a fault that comes
+    /// and goes between two calls leaves the gear as it was.
     pub fn supervise(&mut self, cfg: &FogConfig, closures: u32) {
         let healthy = !self
             .faults
