@@ -5,7 +5,7 @@
 //! These use a 16-bit ADC: with the STM32's 12-bit ADC and no noise the
 //! quantisation floor (about 0.01 deg/h) exceeds 1 % of the 1 000 deg/s^2 drift.
 
-use gyro_sim::vibration_drift::{eps2_instrument, eps2_point, Eps2Point};
+use gyro_sim::vibration_drift::{eps2_instrument, eps2_point, Eps2Point, EPS2_NOISE_SEED};
 use gyro_sp::fog::FogParams;
 use host_tests::*;
 use std::f64::consts::PI;
@@ -46,7 +46,8 @@ fn correction_leaves_at_most_one_percent_on_the_subset() {
     let mut failures = Vec::new();
     for ((phi0, closure), latency, freq, eps) in SUBSET {
         let params = eps2_instrument(phi0, closure, latency);
-        let p: Eps2Point = eps2_point(params, eps, freq, 0.0025, 600.0, |_| {}).unwrap();
+        let p: Eps2Point =
+            eps2_point(params, EPS2_NOISE_SEED, eps, freq, 0.0025, 600.0, |_| {}).unwrap();
         let d = p.drift;
         let at = format!(
             "{:.0}pi/8 {closure} Hz L{latency} {freq} Hz {eps} deg/s2",

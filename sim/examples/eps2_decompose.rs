@@ -24,7 +24,7 @@
 //! `cargo run --release -p gyro-sim --example eps2_decompose -- --eighths 6
 //! --closure 12500 --lat 0 --eps 1000 --hz 200 --secs 3000 [--glg 0]`
 use gyro_sim::vibration_drift::{
-    eps2_instrument, eps2_rig, vibration, Welford, DEG, DPH, EPS2_SETTLE_CLOSURES,
+    eps2_instrument, eps2_rig, vibration, Welford, DEG, DPH, EPS2_NOISE_SEED, EPS2_SETTLE_CLOSURES,
 };
 use gyro_sp::RAD_PER_PHASE_LSB;
 use std::f64::consts::{PI, TAU};
@@ -60,7 +60,7 @@ fn main() {
     let mut params = eps2_instrument(phi0, closure_hz, arg("--lat", 0.0) as u32);
     params.gain_loop_gain = arg("--glg", params.gain_loop_gain);
     params.dither_adc_codes = arg("--dither", params.dither_adc_codes);
-    let Ok(mut rig) = eps2_rig(params, vibration(eps, hz)) else {
+    let Ok(mut rig) = eps2_rig(params, EPS2_NOISE_SEED, vibration(eps, hz)) else {
         eprintln!("configuration refused");
         return;
     };

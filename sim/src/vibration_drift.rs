@@ -236,14 +236,18 @@ pub fn eps2_instrument(phi0_rad: f64, closure_hz: f64, dac_latency: u32) -> FogP
     }
 }
 
-/// The seed of the eps^2 instrument's detector noise (the vibrating rig
+/// The eps^2 bench's default seed of the detector noise (the vibrating rig
 /// and its twin at rest draw the same).
 pub const EPS2_NOISE_SEED: u64 = 1;
 
 /// A rig for `params` (the nominal optics at the ADC resolution
 /// `params.adc_bits`, the detector matched to phi0, its shot and intensity
-/// noise on, drawn from [`EPS2_NOISE_SEED`]) under `profile`.
-pub fn eps2_rig(params: FogParams, profile: Profile<f64>) -> Result<FogRig<f64>, ConfigError> {
+/// noise on, drawn from `seed`) under `profile`.
+pub fn eps2_rig(
+    params: FogParams,
+    seed: u64,
+    profile: Profile<f64>,
+) -> Result<FogRig<f64>, ConfigError> {
     let mut optics = OpticsParams::<f64>::nominal(
         params.tau_s,
         params.samples_per_half,
@@ -251,7 +255,7 @@ pub fn eps2_rig(params: FogParams, profile: Profile<f64>) -> Result<FogRig<f64>,
     );
     optics.adc_bits = params.adc_bits;
     optics.noise = true;
-    optics.seed = EPS2_NOISE_SEED;
+    optics.seed = seed;
     let cfg = FogConfig::new(optics.matched(params))?;
     Ok(FogRig::new(cfg, optics, profile))
 }
@@ -292,14 +296,15 @@ impl Eps2Point {
 /// about `seconds * ((share_left_se / se_target)^2 - 1)`).
 pub fn eps2_point(
     params: FogParams,
+    seed: u64,
     eps_dps2: f64,
     freq_hz: f64,
     se_target: f64,
     max_seconds: f64,
     mut progress: impl FnMut(&Eps2Point),
 ) -> Result<Eps2Point, ConfigError> {
-    let mut rig = eps2_rig(params, vibration(eps_dps2, freq_hz))?;
-    let mut rest = eps2_rig(params, Profile::constant(0.0))?;
+    let mut rig = eps2_rig(params, seed, vibration(eps_dps2, freq_hz))?;
+    let mut rest = eps2_rig(params, seed, Profile::constant(0.0))?;
     let formula_dph = rig
         .cfg
         .predicted_vibration_drift((eps_dps2 * DEG).powi(2) / 2.0)

@@ -106,6 +106,8 @@ pub struct Eps2Plan {
     /// Simulated seconds per point at most.
     pub max_seconds: f64,
     pub threads: usize,
+    /// Seed of the instrument's detector noise.
+    pub seed: u64,
 }
 
 /// What the progress callback hears: a point finished (its index in the
@@ -145,6 +147,7 @@ pub fn run(
                 let mut blocks = 0u64;
                 let r = eps2_point(
                     eps2_instrument(spec.phi0_rad, spec.closure_hz, spec.dac_latency),
+                    plan.seed,
                     spec.eps_dps2,
                     spec.freq_hz,
                     plan.se_target,
@@ -250,6 +253,7 @@ mod tests {
             se_target: 1.0,
             max_seconds: 2.0,
             threads: 1,
+            seed: gyro_sim::vibration_drift::EPS2_NOISE_SEED,
         };
         let rows = run(&[spec], plan, &|_| {}).unwrap();
         assert_eq!(rows.len(), 1);

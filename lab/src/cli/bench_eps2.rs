@@ -33,6 +33,10 @@ pub struct Eps2BenchArgs {
     /// Threads (default: the cores available).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Seed of the detector noise (the vibrating rig and its twin at rest
+    /// draw the same; another seed is an independent measurement).
+    #[arg(long, default_value_t = gyro_sim::vibration_drift::EPS2_NOISE_SEED)]
+    pub seed: u64,
     #[command(flatten)]
     pub json: Json,
 }
@@ -157,6 +161,7 @@ pub fn run_bench(a: &Eps2BenchArgs) -> Result<(), LabError> {
         se_target: a.se,
         max_seconds: a.max_s,
         threads,
+        seed: a.seed,
     };
     let rows = run(&points, plan, &progress)
         .map_err(|e| LabError::Bench(format!("bench eps2: loop configuration {e:?}")))?;
