@@ -22,6 +22,7 @@
 //!   residual (the simulated Sagnac phase less the feedback phase applied),
 //!   `sum(r_meas * r_true) / sum(r_true^2)`.
 
+use crate::fog_rig::RigClosure;
 use crate::{FogRig, OpticsParams, Profile, Segment};
 use core::f64::consts::PI;
 use gyro_sp::fog::config::ConfigError;
@@ -131,16 +132,23 @@ impl DriftMeter {
     pub fn run_block(&mut self, rig: &mut FogRig<f64>, mut rest: Option<&mut FogRig<f64>>) {
         let lsb = rig.cfg.rad_s_per_phase_lsb();
         let ks = rig.cfg.k_sagnac_s;
+        // A closure's output error (rad/s), uncorrected and corrected.
+        let error = |c: &RigClosure<f64>| {
+            (
+                c.out.sagnac_phase as f64 * lsb - c.true_rate,
+                c.out.sagnac_phase_corrected as f64 * lsb - c.true_rate,
+            )
+        };
         let (mut raw, mut corrected) = (0.0, 0.0);
         for _ in 0..self.block {
             let s = rig.run_closure();
-            raw += s.out.sagnac_phase as f64 * lsb - s.true_rate;
-            corrected += s.out.sagnac_phase_corrected as f64 * lsb - s.true_rate;
+            let (mut r, mut c) = error(&s);
             if let Some(twin) = rest.as_deref_mut() {
-                let t = twin.run_closure();
-                raw -= t.out.sagnac_phase as f64 * lsb - t.true_rate;
-                corrected -= t.out.sagnac_phase_corrected as f64 * lsb - t.true_rate;
+                let (tr, tc) = error(&twin.run_closure());
+                (r, c) = (r - tr, c - tc);
             }
+            raw += r;
+            corrected += c;
             let applied = (s.out.sagnac_phase - s.out.residual as i64) as f64 * RAD_PER_PHASE_LSB;
             let truth = ks * s.true_rate - applied;
             self.md += s.out.residual as f64 * RAD_PER_PHASE_LSB * truth;

@@ -117,7 +117,7 @@ impl GainLoop {
         } else {
             0
         };
-        self.gain = if self.in_lock >= cfg.acquire_closures {
+        self.gain = if self.tracking(cfg) {
             cfg.track_gain
         } else {
             cfg.gain
