@@ -18,7 +18,9 @@
 //! - every effect of the library near 1.5 times the noise floor (its 1 s
 //!   means' RMS 1.5 times the white noise of a 1 s mean).
 
-use super::discover_trials::{draw, effect_of, signed, uni, Outside, Trial, TrialKind};
+use super::discover_trials::{
+    bench_effects, draw, effect_of, signed, uni, Outside, Trial, TrialKind,
+};
 use crate::model::discovery::windows::Windows;
 use crate::model::effects::Effect;
 use crate::model::gyro_model::ModelEffect;
@@ -123,7 +125,8 @@ pub fn trials(a: &TrialCounts) -> Vec<Trial> {
         seed += 1;
         seed
     };
-    for e in Effect::ALL {
+    let effects = bench_effects();
+    for &e in &effects {
         for _ in 0..a.per_effect {
             let (p, h, known) = draw(e, &mut rng);
             out.push(Trial::hiding(
@@ -136,7 +139,7 @@ pub fn trials(a: &TrialCounts) -> Vec<Trial> {
         }
     }
     for i in 0..a.nothing {
-        let e = Effect::ALL[(i as usize) % Effect::ALL.len()];
+        let e = effects[(i as usize) % effects.len()];
         let (p, h, mut known) = draw(e, &mut rng);
         known.push(h);
         out.push(Trial::hiding(
@@ -239,7 +242,7 @@ pub fn trials(a: &TrialCounts) -> Vec<Trial> {
             out.push(t);
         }
     }
-    for e in Effect::ALL {
+    for &e in &effects {
         for _ in 0..a.weak {
             let (p, h, known) = draw(e, &mut rng);
             let s = next();

@@ -674,12 +674,12 @@ fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
             }
             None => {
                 let run = crate::cli::discover::read_run(&csv)?;
-                let g = if t.gyro == "rlg" {
-                    GyroKind::Rlg
-                } else {
-                    GyroKind::Fog
-                };
-                crate::cli::discover::json(&run_discover(&Model::ideal(g), &run))
+                let g = GyroKind::from_name(&t.gyro).unwrap_or(GyroKind::Fog);
+                crate::cli::discover::json(&run_discover(
+                    &Model::ideal(g),
+                    &run,
+                    &Default::default(),
+                ))
             }
         };
         scored.push(score(t, &r));

@@ -17,12 +17,27 @@
 //! | vibration_rectification | c eps^2/3600 (eps the angular acceleration, deg/s^2; docs/fog.md) | ref_acc_dps2 or ref_rate_dps |
 //! | lock_in | sign(w) sqrt(w^2 - W_L^2) - w, or -w inside the lock band (docs/rlg.md) | - |
 //! | thermal_difference | k1 dT/3600, dT = t_mono_a - t_mono_b | t_mono_a_c, t_mono_b_c |
-//! | thermal_gradient | k2 grad(dT)/3600 (the firmware's 20 s filtered derivative) | t_mono_a_c, t_mono_b_c |
+//! | thermal_gradient | k2 d(dT)/dt /3600, the rate of dT as the least-squares slope over +-60 s | t_mono_a_c, t_mono_b_c |
 //! | thermal_difference_squared | k3 dT^2/3600 | t_mono_a_c, t_mono_b_c |
 //! | case_temperature | k4 (T_K - 20)/3600 | t_case_c |
 //! | warm_up | A (1 - exp(-t/tau))/3600, t since power-on | - |
 //! | bias_temperature | b (T - 20)/3600 (FOG coil; docs/fog.md, thermal bias) | temp_c |
 //! | shupe | s dT/dt /3600, dT/dt the coil temperature's rate (the least-squares slope over +-30 s) | temp_c |
+//! | bias_temperature_rate | s dT/dt /3600 (MEMS: a bias that follows the die temperature's rate, the package's thermal gradient and stress) | temp_c |
+//!
+//! Which gyro each belongs to ([`Effect::applies_to`]): lock-in and the
+//! monoblock and case terms to the RLG (physics.md 2.3), rectification
+//! and the Shupe bias to the FOG, the rate term under its own name to the
+//! MEMS gyro (no Shupe effect there: no fibre), the knee to the FOG and
+//! RLG; the bias, the scale factor and its temperature term, the bias
+//! over temperature (FOG and MEMS) and the warm-up as the physics says.
+//!
+//! The gradient's coefficient k2 is the physical one (deg/h per degC/s):
+//! the firmware applies it to its causal 20 s filtered derivative, whose
+//! noise on quantised sensors (a hundredth of a degree every few seconds
+//! differenced and filtered) is as large as the rate itself; fitted on it
+//! the coefficient is attenuated and the effect loses to smoother shapes
+//! (issue 31). The lab has the whole record and uses the centred slope.
 //!
 //! Each parameter has a physical range (ranges.rs): a fit outside it is
 //! not that effect.
@@ -48,6 +63,7 @@ pub enum Effect {
     WarmUp,
     BiasTemperature,
     Shupe,
+    BiasTemperatureRate,
 }
 
 /// An effect's contribution for a non-linear parameter: its columns (deg/s
@@ -62,7 +78,7 @@ const PPM: f64 = 1e-6;
 pub const DPH: f64 = 1.0 / 3600.0;
 
 impl Effect {
-    pub const ALL: [Effect; 14] = [
+    pub const ALL: [Effect; 15] = [
         Effect::Bias,
         Effect::ScaleFactorError,
         Effect::ScaleFactorAsymmetry,
@@ -77,6 +93,7 @@ impl Effect {
         Effect::WarmUp,
         Effect::BiasTemperature,
         Effect::Shupe,
+        Effect::BiasTemperatureRate,
     ];
 
     pub fn name(self) -> &'static str {
@@ -95,6 +112,7 @@ impl Effect {
             Effect::WarmUp => "warm_up",
             Effect::BiasTemperature => "bias_temperature",
             Effect::Shupe => "shupe",
+            Effect::BiasTemperatureRate => "bias_temperature_rate",
         }
     }
 
@@ -117,17 +135,24 @@ impl Effect {
         Effect::ScaleFactorKnee.nonlinear_param() == Some(param)
     }
 
-    /// The effects of each gyro's physics: lock-in belongs to the RLG;
-    /// vibration rectification and the coil's thermal bias (linear in
-    /// its temperature, and the Shupe effect) to the closed-loop FOG; the
-    /// rest to both.
+    /// The effects of each gyro's physics (the module's table).
     pub fn applies_to(self, g: GyroKind) -> bool {
+        use GyroKind::*;
         match self {
-            Effect::LockIn => g == GyroKind::Rlg,
-            Effect::VibrationRectification | Effect::BiasTemperature | Effect::Shupe => {
-                g == GyroKind::Fog
-            }
-            _ => true,
+            Effect::LockIn
+            | Effect::ThermalDifference
+            | Effect::ThermalGradient
+            | Effect::ThermalDifferenceSquared
+            | Effect::CaseTemperature => g == Rlg,
+            Effect::VibrationRectification | Effect::Shupe => g == Fog,
+            Effect::BiasTemperature => g == Fog || g == Mems,
+            Effect::BiasTemperatureRate => g == Mems,
+            Effect::ScaleFactorKnee => g != Mems,
+            Effect::Bias
+            | Effect::ScaleFactorError
+            | Effect::ScaleFactorAsymmetry
+            | Effect::ScaleFactorTemperature
+            | Effect::WarmUp => true,
         }
     }
 
@@ -167,7 +192,7 @@ impl Effect {
             Effect::CaseTemperature => &["dph_per_c"],
             Effect::WarmUp => &["amplitude_dph"],
             Effect::BiasTemperature => &["dph_per_c"],
-            Effect::Shupe => &["dph_per_c_per_s"],
+            Effect::Shupe | Effect::BiasTemperatureRate => &["dph_per_c_per_s"],
         }
     }
 
@@ -194,7 +219,8 @@ impl Effect {
             Effect::ScaleFactorTemperature
             | Effect::ScaleFactorKnee
             | Effect::BiasTemperature
-            | Effect::Shupe => &[Column::Temp],
+            | Effect::Shupe
+            | Effect::BiasTemperatureRate => &[Column::Temp],
             Effect::ThermalDifference
             | Effect::ThermalGradient
             | Effect::ThermalDifferenceSquared => &[Column::MonoA, Column::MonoB],
@@ -208,7 +234,8 @@ impl Effect {
             Effect::ScaleFactorTemperature
             | Effect::ScaleFactorKnee
             | Effect::BiasTemperature
-            | Effect::Shupe => inp.temp.is_some(),
+            | Effect::Shupe
+            | Effect::BiasTemperatureRate => inp.temp.is_some(),
             Effect::ThermalDifference
             | Effect::ThermalGradient
             | Effect::ThermalDifferenceSquared => inp.dt.is_some(),
@@ -246,7 +273,7 @@ impl Effect {
             }
             Effect::WarmUp => vec![col(&|k| DPH * (1.0 - (-inp.t[k] / x.max(1e-9)).exp()))],
             Effect::BiasTemperature => vec![col(&|k| DPH * (temp[k] - 20.0))],
-            Effect::Shupe => {
+            Effect::Shupe | Effect::BiasTemperatureRate => {
                 let g = inp.temp_rate.as_ref().unwrap_or(&zeros);
                 vec![col(&|k| DPH * g[k])]
             }

@@ -1,12 +1,12 @@
 //! The model file, model.toml (README.md): `kind = "gyro_model"`,
-//! `version`, `gyro = "fog"|"rlg"`, an optional `[nominal]` table, then
+//! `version`, `gyro = "fog"|"rlg"|"mems"`, an optional `[nominal]` table, then
 //! `[[effect]]` tables with `name` and the effect's parameters. Read from
 //! and written to text here; the commands do the files.
 //!
 //! ```toml
 //! kind = "gyro_model"
 //! version = 1
-//! gyro = "fog"                 # or "rlg"
+//! gyro = "fog"                 # or "rlg", "mems"
 //! [nominal]                    # optional, informative (e.g. phi0_rad, closure_hz)
 //! [[effect]]
 //! name = "bias"
@@ -211,10 +211,9 @@ pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Vec<Places>)
             ),
         ));
     }
-    let gyro = match raw.gyro.get_ref().as_str() {
-        "fog" => GyroKind::Fog,
-        "rlg" => GyroKind::Rlg,
-        g => return Err(at(raw.gyro.span(), format!("gyro `{g}`: fog or rlg"))),
+    let Some(gyro) = GyroKind::from_name(raw.gyro.get_ref()) else {
+        let g = raw.gyro.get_ref();
+        return Err(at(raw.gyro.span(), format!("gyro `{g}`: fog, rlg or mems")));
     };
     if gyro != expect {
         let (line, column) = place(text, raw.gyro.span().start);

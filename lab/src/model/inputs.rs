@@ -4,6 +4,11 @@
 
 use crate::numerics::thermal_difference::dt_and_gradient;
 
+/// Half width of the monoblock difference's slope, s: its sensors are
+/// read in hundredths of a degree (or sixteenths) every second or two,
+/// and its lags are thousands of seconds.
+pub const GRADIENT_HALF_WIDTH_S: f64 = 60.0;
+
 /// Half width of the temperature rate's slope, s: wide enough to average
 /// a sensor's quantization and noise, short against a coil's thermal lag
 /// (minutes).
@@ -59,7 +64,8 @@ pub struct Inputs {
     pub temp: Option<Vec<f64>>,
     pub temp_rate: Option<Vec<f64>>,
     /// Monoblock difference dT (clamped to +-32 degC as the firmware does)
-    /// and its filtered derivative, degC and degC/s.
+    /// and its rate (the least-squares slope over [`GRADIENT_HALF_WIDTH_S`]
+    /// either side), degC and degC/s.
     pub dt: Option<Vec<f64>>,
     pub grad: Option<Vec<f64>>,
     /// Case sensor, degC.
@@ -82,7 +88,8 @@ impl Inputs {
     ) -> Self {
         let (dt, grad) = match mono {
             Some((a, b)) => {
-                let (d, g) = dt_and_gradient(&t, &a, &b);
+                let (d, _) = dt_and_gradient(&t, &a, &b);
+                let g = centered_slope(&t, &d, GRADIENT_HALF_WIDTH_S);
                 (Some(d), Some(g))
             }
             None => (None, None),

@@ -127,7 +127,7 @@ impl Extra {
 }
 
 impl TrialNoise {
-    /// A navigation-grade gyro of each kind.
+    /// A navigation-grade FOG or RLG, an industrial MEMS gyro.
     pub fn nominal(g: GyroKind) -> Self {
         match g {
             GyroKind::Fog => Self {
@@ -138,6 +138,12 @@ impl TrialNoise {
             GyroKind::Rlg => Self {
                 arw_dpsh: 0.003,
                 bias_instability_dph: 0.003,
+                rate_random_walk_dphsh: 0.0,
+            },
+            // An industrial MEMS gyro (discover --gyro mems).
+            GyroKind::Mems => Self {
+                arw_dpsh: 0.3,
+                bias_instability_dph: 10.0,
                 rate_random_walk_dphsh: 0.0,
             },
         }

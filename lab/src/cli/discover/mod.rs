@@ -11,8 +11,9 @@ use crate::data::residual_file;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
 use crate::model::discovery::estimates::Estimate;
-use crate::model::discovery::{discover, Discovery, Run, WINDOW_S};
+use crate::model::discovery::{discover, Discovery, Options, Run, WINDOW_S};
 use crate::model::effects::Effect;
+use crate::model::grade::Grade;
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
@@ -27,6 +28,8 @@ use std::path::{Path, PathBuf};
 pub enum GyroArg {
     Fog,
     Rlg,
+    /// A MEMS rate gyro with one temperature sensor (temp_c).
+    Mems,
 }
 
 impl From<GyroArg> for GyroKind {
@@ -34,6 +37,27 @@ impl From<GyroArg> for GyroKind {
         match g {
             GyroArg::Fog => GyroKind::Fog,
             GyroArg::Rlg => GyroKind::Rlg,
+            GyroArg::Mems => GyroKind::Mems,
+        }
+    }
+}
+
+/// The grades, as the command line names them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GradeArg {
+    Navigation,
+    Tactical,
+    Industrial,
+    Consumer,
+}
+
+impl From<GradeArg> for Grade {
+    fn from(g: GradeArg) -> Self {
+        match g {
+            GradeArg::Navigation => Grade::Navigation,
+            GradeArg::Tactical => Grade::Tactical,
+            GradeArg::Industrial => Grade::Industrial,
+            GradeArg::Consumer => Grade::Consumer,
         }
     }
 }
@@ -42,6 +66,14 @@ impl From<GyroArg> for GyroKind {
 pub struct DiscoverArgs {
     #[arg(long, value_enum)]
     pub gyro: GyroArg,
+    /// The gyro's grade: sets the physical ranges of the effects'
+    /// parameters (judged from the run's white noise without it).
+    #[arg(long, value_enum)]
+    pub grade: Option<GradeArg>,
+    /// Another run of the same gyro: the model written must predict it
+    /// too (up to a bias).
+    #[arg(long)]
+    pub validate: Option<PathBuf>,
     /// The model (model.toml); the ideal gyro without it.
     #[arg(long)]
     pub model: Option<PathBuf>,
@@ -160,6 +192,7 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "intervals_note": d.short,
         "windows": d.windows.len(),
         "gyro": d.gyro.name(),
+        "grade": d.grade,
     })
 }
 
@@ -192,22 +225,104 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
             ),
         ));
     }
-    let d = discover(&model, &data);
+    let opts = Options {
+        grade: a.grade.map(Grade::from),
+    };
+    let d = discover(&model, &data, &opts);
+    // The model written, on another run of the same gyro: what it still
+    // misses there.
+    let validation = match &a.validate {
+        Some(p) => {
+            let v = read_run(p)?;
+            if let Some((e, cols)) = d.model_after.missing_inputs(&v.inputs).first() {
+                return Err(LabError::input(
+                    p,
+                    format!(
+                        "the model's effect `{}` needs column(s) {} that this run lacks",
+                        e.name(),
+                        cols.iter()
+                            .map(|c| format!("`{}`", c.name()))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                ));
+            }
+            let opts_v = Options {
+                grade: Some(d.grade.value),
+            };
+            Some((p.clone(), discover(&d.model_after, &v, &opts_v)))
+        }
+        None => None,
+    };
     write_files(a, &d, &data)?;
     if a.json.json {
         let mut j = json(&d);
+        if let Some((p, v)) = &validation {
+            j["validation"] = validation_json(p, v);
+        }
         j["elapsed_s"] = t0.elapsed().as_secs_f64().into();
         println!("{j}");
         return Ok(());
     }
     print_text(a, &d);
+    if let Some((p, v)) = &validation {
+        print_validation(p, v);
+    }
     Ok(())
+}
+
+/// Whether the model written predicts another run of the same gyro: there
+/// it needs nothing more than a bias, and leaves nothing unexplained.
+fn predicts(v: &Discovery) -> bool {
+    v.found.iter().all(|e| e.effect == Effect::Bias) && v.unexplained.is_none()
+}
+
+/// The JSON of the validation run: the model written, on it.
+fn validation_json(path: &Path, v: &Discovery) -> serde_json::Value {
+    let bias = v
+        .found
+        .iter()
+        .chain(v.carried.iter().map(|c| &c.estimate))
+        .find(|e| e.effect == Effect::Bias)
+        .map(estimate_json);
+    serde_json::json!({
+        "data": path,
+        "gap_before_dph": v.gap_before_dph,
+        "gap_after_dph": v.gap_after_dph,
+        "noise_floor_dph": v.noise_floor_dph,
+        "found": v.found.iter().map(|e| e.effect).collect::<Vec<_>>(),
+        "bias": bias,
+        "unexplained": v.unexplained.is_some(),
+        "predicts": predicts(v),
+    })
+}
+
+fn print_validation(path: &Path, v: &Discovery) {
+    let names: Vec<&str> = v.found.iter().map(|e| e.effect.name()).collect();
+    println!(
+        "validation on {}: the model written leaves a gap of {:.4} deg/h (noise floor {:.4}); {} -> {:.4} deg/h; {}",
+        path.display(),
+        v.gap_before_dph,
+        v.noise_floor_dph,
+        if names.is_empty() {
+            "nothing more needed".to_owned()
+        } else {
+            format!("it still needs {}", names.join(", "))
+        },
+        v.gap_after_dph,
+        if predicts(v) {
+            "it predicts this run up to a bias"
+        } else {
+            "it does NOT predict this run up to a bias"
+        }
+    );
 }
 
 /// What a run covers, for the model's domains that depend on it.
 fn run_extent(data: &Run) -> Extent {
     let t = &data.inputs.t;
     Extent {
+        grade: Grade::Navigation,
         record_s: t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0),
         temp_c: data.inputs.temp.as_ref().map(|v| {
             v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {

@@ -33,6 +33,7 @@ pub mod windows;
 
 use crate::data::run_file::Column;
 use crate::model::effects::Effect;
+use crate::model::grade::{Grade, GradeChoice};
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::{Model, ModelEffect};
 use crate::model::inputs::Inputs;
@@ -63,6 +64,18 @@ pub struct Run {
     pub rate: Vec<f64>,
 }
 
+/// What the user sets.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// The gyro's grade (`--grade`); judged from the run's white noise
+    /// when None.
+    pub grade: Option<Grade>,
+}
+
+/// The least rate, deg/s, a run must reach beyond the Earth rate (0.004
+/// deg/s) for lock-in to show: a lock-in rate below it is not an RLG's.
+pub const LOCK_IN_MIN_DPS: f64 = 0.01;
+
 /// An effect of the library the run cannot show, and why.
 #[derive(Clone, Debug)]
 pub struct Skipped {
@@ -81,6 +94,7 @@ pub struct Carried {
 
 pub struct Discovery {
     pub gyro: GyroKind,
+    pub grade: GradeChoice,
     /// Named effects, in the order they came in (a bias first).
     pub found: Vec<Estimate>,
     pub carried: Vec<Carried>,
@@ -120,10 +134,36 @@ fn residual(model: &Model, run: &Run) -> Vec<f64> {
     run.rate.iter().zip(&sim).map(|(y, s)| y - s).collect()
 }
 
+/// Why the run cannot show `e` (it has its inputs), or None where it can:
+/// each effect judged where it shows. A scale factor needs the table to
+/// turn; lock-in needs the rate to reach beyond the Earth rate and to
+/// change (at one rate it is a constant, a bias), however slowly: a run in
+/// the lock-in regime never reaches a scale factor's rates.
+fn cannot_show(e: Effect, inp: &Inputs) -> Option<String> {
+    if e == Effect::LockIn {
+        let (lo, hi) = inp
+            .w
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &w| {
+                (a.0.min(w.abs()), a.1.max(w.abs()))
+            });
+        return (hi < LOCK_IN_MIN_DPS || hi - lo < LOCK_IN_MIN_DPS).then(|| {
+            format!(
+                "the rate never reaches {LOCK_IN_MIN_DPS} deg/s beyond the Earth rate, or never changes: lock-in cannot show"
+            )
+        });
+    }
+    (e.needs_rotation() && !rotating(inp)).then(|| {
+        format!(
+            "the run does not turn (no rate of {} deg/s): a scale factor cannot show at rest",
+            terms::ROTATING_DPS
+        )
+    })
+}
+
 /// The library's effects of this gyro the run can show (the bias aside:
-/// every fit carries its constant), and those it cannot.
+/// every fit carries its constant), and those of this gyro it cannot.
 fn candidates(gyro: GyroKind, inp: &Inputs) -> (Vec<Effect>, Vec<Skipped>) {
-    let turns = rotating(inp);
     let mut ok = vec![];
     let mut skipped = vec![];
     for e in Effect::ALL.into_iter().filter(|e| e.applies_to(gyro)) {
@@ -133,14 +173,11 @@ fn candidates(gyro: GyroKind, inp: &Inputs) -> (Vec<Effect>, Vec<Skipped>) {
                 missing: e.needs(),
                 reason: "the run lacks its inputs".into(),
             });
-        } else if e.needs_rotation() && !turns {
+        } else if let Some(reason) = cannot_show(e, inp) {
             skipped.push(Skipped {
                 effect: e,
                 missing: &[],
-                reason: format!(
-                    "the run does not turn (no rate of {} deg/s): a scale factor cannot show at rest",
-                    terms::ROTATING_DPS
-                ),
+                reason,
             });
         } else if e != Effect::Bias {
             ok.push(e);
@@ -149,8 +186,15 @@ fn candidates(gyro: GyroKind, inp: &Inputs) -> (Vec<Effect>, Vec<Skipped>) {
     (ok, skipped)
 }
 
-/// What a run covers.
-fn extent(inp: &Inputs) -> Extent {
+/// The run's angle random walk, deg/sqrt(h), from the noise floor of its
+/// window means (`floor_dph`, over windows `tau` s apart): the white noise
+/// that tells the grade.
+pub fn arw_of_floor(floor_dph: f64, tau: f64) -> f64 {
+    floor_dph * tau.max(WINDOW_S).sqrt() / 60.0
+}
+
+/// What a run covers, and the grade its ranges are judged at.
+fn extent(inp: &Inputs, grade: Grade) -> Extent {
     let t0 = inp.t.first().copied().unwrap_or(0.0);
     let t1 = inp.t.last().copied().unwrap_or(0.0);
     let temp_c = inp.temp.as_ref().map(|v| {
@@ -161,6 +205,7 @@ fn extent(inp: &Inputs) -> Extent {
     Extent {
         record_s: (t1 - t0).max(0.0),
         temp_c,
+        grade,
     }
 }
 
@@ -186,9 +231,10 @@ fn passes<'a>(
     r: &[f64],
     rw: &[f64],
     cands: &[Effect],
+    grade: Grade,
 ) -> (Design<'a>, Selection, NoiseModel, Transients, usize) {
     let n = win.len();
-    let x = extent(inp);
+    let x = extent(inp, grade);
     let all = vec![true; n];
     let white = NoiseModel::white_of(rw, &all);
     if n < MIN_COLOUR_WINDOWS {
@@ -305,6 +351,22 @@ fn allow_slow_noise(d: &Design, terms: &[Term], noise: &NoiseModel, fin: &mut es
     }
 }
 
+/// Why an effect whose interval holds zero is carried, not named.
+pub const NOT_SIGNIFICANT: &str =
+    "its 95 % interval holds zero (or the record gives it none), so the data do not show it";
+
+/// Whether `e`'s 95 % interval holds zero: every linear parameter's, or,
+/// for an effect with none (lock-in), its non-linear one's; an interval
+/// the record cannot give (NaN) holds it too.
+pub fn holds_zero(e: &Estimate) -> bool {
+    let lin = e.effect.linear_params();
+    let holds = |p: &(&str, f64, f64, f64)| !(p.2 > 0.0 || p.3 < 0.0);
+    if lin.is_empty() {
+        return e.params.iter().all(holds);
+    }
+    e.params.iter().filter(|p| lin.contains(&p.0)).all(holds)
+}
+
 /// A model effect from an estimate's values.
 fn model_effect(e: &Estimate) -> ModelEffect {
     ModelEffect {
@@ -370,15 +432,29 @@ fn plain_refit(d: &Design, written: &[(Term, Estimate)]) -> Vec<Estimate> {
         .collect()
 }
 
+/// The median spacing of the windows' mid times, s.
+fn window_spacing(win: &Windows) -> f64 {
+    let mut d: Vec<f64> = win.t.windows(2).map(|p| p[1] - p[0]).collect();
+    if d.is_empty() {
+        return WINDOW_S;
+    }
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
 /// What `model` misses of `run`: the effects found, the model with them
 /// added, the residual before and after, and what stays unexplained.
-pub fn discover(model: &Model, run: &Run) -> Discovery {
+pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let inp = &run.inputs;
     let r = residual(model, run);
     let win = Windows::new(&inp.t, WINDOW_S);
     let rw = win.mean(&r);
     let allan_before = allan_of(&inp.t, &r);
     let floor = noise_floor(&win, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
+    let grade = match opts.grade {
+        Some(g) => GradeChoice::given(g),
+        None => GradeChoice::inferred(arw_of_floor(floor, window_spacing(&win))),
+    };
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
     let (cands, skipped) = candidates(model.gyro, inp);
     // The selection, run again without any named effect the fit does not
@@ -390,7 +466,7 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
             .copied()
             .filter(|e| !not_confirmed.iter().any(|x| x.0 == *e))
             .collect();
-        let out = passes(inp, &win, &r, &rw, &now);
+        let out = passes(inp, &win, &r, &rw, &now, grade.value);
         if out.0.win.len() < MIN_COLOUR_WINDOWS || not_confirmed.len() >= confirm::MAX_SET_ASIDE {
             break out;
         }
@@ -428,6 +504,9 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     if role != Role::Unneeded {
         if let Some(e) = est(0) {
             let why = match role {
+                Role::Named if holds_zero(&e) => Some(format!(
+                    "the constant the other terms are fitted with (not named a bias: {NOT_SIGNIFICANT})"
+                )),
                 Role::Named => None,
                 Role::Ambiguous => Some("the constant, for the ambiguous group it heads".into()),
                 _ if not_confirmed.iter().any(|x| x.0 == Effect::Bias) => Some(
@@ -444,7 +523,8 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     }
     for j in 1..=nn {
         if let Some(e) = est(j) {
-            written.push((terms[j], e, None));
+            let why = holds_zero(&e).then(|| format!("not named: {NOT_SIGNIFICANT}"));
+            written.push((terms[j], e, why));
         }
     }
     for j in nn + 1..=nn + nc {
@@ -519,6 +599,7 @@ pub fn discover(model: &Model, run: &Run) -> Discovery {
     let allan_after = allan_of(&inp.t, &r_after);
     Discovery {
         gyro: model.gyro,
+        grade,
         found,
         carried,
         ambiguous,

@@ -75,7 +75,7 @@ impl Profile {
 
     fn noise(self) -> Noise {
         let (arw, fl) = match self.gyro() {
-            GyroKind::Fog => (0.004, 0.006),
+            GyroKind::Fog | GyroKind::Mems => (0.004, 0.006),
             GyroKind::Rlg => (0.0025, 0.004),
         };
         Noise {
