@@ -18,6 +18,9 @@ pub struct Truth {
     pub gyro: String,
     pub expect: Vec<String>,
     pub truth: BTreeMap<String, BTreeMap<String, f64>>,
+    /// A second day of the same gyro (the third generator's MEMS runs).
+    #[serde(default)]
+    pub validate: Option<String>,
 }
 
 /// A run's score.
@@ -155,6 +158,7 @@ mod tests {
             category: "bias + thermal term (RLG chamber)".into(),
             gyro: "rlg".into(),
             expect: vec!["bias".into(), "case_temperature".into()],
+            validate: None,
             truth: [
                 ("bias".to_owned(), [("bias_dph".to_owned(), 0.5)].into()),
                 (

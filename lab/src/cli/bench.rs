@@ -6,12 +6,9 @@ use crate::bench::allan::{
     against_definition, judge, recovery, speed_record, truth_present, Recovery, Scenario,
     Selection, SAMPLES, SCENARIOS, SHORT, SPEED_TAU0_S, TAU0_S,
 };
-use crate::bench::discover_categories::{trials, TrialCounts};
-use crate::bench::discover_summary::{summarize, Summary};
-use crate::bench::discover_trials::run_all;
 use crate::bench::lockin::{table, RECORDS};
 use crate::bench::scale_factor::{self, ScaleFactorBench};
-use crate::cli::args::{Json, Seed};
+use crate::cli::args::Json;
 use crate::cli::output::{print_json, progress_bar};
 use crate::data::csv_writer::CellFormat::{Exp, Fixed};
 use crate::data::run_file::{Column, RunWriter, Series};
@@ -32,11 +29,11 @@ pub enum BenchCmd {
     /// Allan analysis time on 10^7 samples against the O(N m) definition.
     AllanSpeed(SpeedArgs),
     /// Discovery on randomized runs with hidden effects: the confusion table.
-    Discover(DiscoverBenchArgs),
+    Discover(crate::cli::discover::bench::DiscoverBenchArgs),
     /// The recorder on a ten-minute capture: the CPU it needs at the board's rate.
     Record(crate::cli::bench_record::RecordBenchArgs),
     /// Discovery on the second generator's held-out set (`simulate heldout`): right, false names, coverage.
-    DiscoverHeldout(HeldOutBenchArgs),
+    DiscoverHeldout(crate::cli::discover::bench::HeldOutBenchArgs),
     /// The online eps^2 correction over the vibration envelope: the table of issue 23.
     Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
 }
@@ -47,9 +44,9 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::ScaleFactor(a) => scale_factor(a),
         BenchCmd::Allan(a) => allan(a),
         BenchCmd::AllanSpeed(a) => allan_speed(a),
-        BenchCmd::Discover(a) => discover(a),
+        BenchCmd::Discover(a) => crate::cli::discover::bench::discover(a),
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
-        BenchCmd::DiscoverHeldout(a) => discover_heldout(a),
+        BenchCmd::DiscoverHeldout(a) => crate::cli::discover::bench::discover_heldout(a),
         BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
     }
 }
@@ -498,246 +495,5 @@ fn allan_speed(a: &SpeedArgs) -> Result<(), LabError> {
         );
     }
     println!("{j}");
-    Ok(())
-}
-
-#[derive(Args, Debug, Clone)]
-pub struct DiscoverBenchArgs {
-    /// Trials per effect of the library (14 effects), alone and near 1.5
-    /// times the noise floor.
-    #[arg(long, default_value_t = 8)]
-    pub per_effect: u64,
-    #[arg(long, default_value_t = 1)]
-    pub weak: u64,
-    /// Trials with nothing missing, with two effects, with collinear ones,
-    /// nulls with coloured noise, decaying warm-ups.
-    #[arg(long, default_value_t = 14)]
-    pub nothing: u64,
-    #[arg(long, default_value_t = 8)]
-    pub pairs: u64,
-    #[arg(long, default_value_t = 8)]
-    pub collinear: u64,
-    #[arg(long, default_value_t = 12)]
-    pub coloured: u64,
-    #[arg(long, default_value_t = 10)]
-    pub decaying: u64,
-    /// Trials per thermal term with a bias (5 terms), per disturbance
-    /// outside the library (5).
-    #[arg(long, default_value_t = 3)]
-    pub bias_thermal: u64,
-    #[arg(long, default_value_t = 3)]
-    pub outside: u64,
-    #[command(flatten)]
-    pub seed: Seed,
-    #[command(flatten)]
-    pub json: Json,
-}
-
-fn print_discover(s: &Summary, n: usize) {
-    println!("discovery on {n} randomized trials (hidden effects, drawn parameters and seeds; the project's generators)");
-    println!("confusion: what was hidden (rows) against what was said");
-    for (row, cols) in &s.confusion {
-        let cells: Vec<String> = cols
-            .iter()
-            .filter(|(k, _)| *k != "trials" && *k != "right")
-            .map(|(k, v)| format!("{k} {v}"))
-            .collect();
-        println!(
-            "  {:<50} {:>3} trials, {:>3} right: {}",
-            row,
-            cols.get("trials").copied().unwrap_or(0),
-            cols.get("right").copied().unwrap_or(0),
-            cells.join(", ")
-        );
-    }
-    println!(
-        "{:<36} {:>6} {:>6} {:>6} {:>9} {:>11} {:>12}",
-        "category", "trials", "right", "false", "gap grew", "unexplained", "coverage"
-    );
-    let mut rows: Vec<(&String, &crate::bench::discover_summary::Tally)> =
-        s.categories.iter().collect();
-    let all = "all".to_string();
-    rows.push((&all, &s.total));
-    for (name, t) in rows {
-        println!(
-            "{:<36} {:>6} {:>6} {:>6} {:>9} {:>11} {:>5}/{:<3} {:>5.1} %",
-            name,
-            t.trials,
-            t.right,
-            t.false_names,
-            t.gap_grew,
-            t.unexplained,
-            t.covered,
-            t.intervals,
-            t.coverage_pct()
-        );
-    }
-    let t = &s.total;
-    println!(
-        "right {}/{} ({:.1} %); false names {}; the gap grew in {}; 95 % intervals hold the truth for {}/{} parameters ({:.1} %) of the named hidden effects; \
-         of those named right, every parameter within 10 %: {}/{}, the gap to reality shrunk 80 %: {}/{}",
-        t.right,
-        t.trials,
-        100.0 * t.right as f64 / t.trials.max(1) as f64,
-        t.false_names,
-        t.gap_grew,
-        t.covered,
-        t.intervals,
-        t.coverage_pct(),
-        t.params_ok,
-        t.named_right_with_truth,
-        t.gap_ok,
-        t.named_right_with_truth
-    );
-}
-
-fn discover(a: &DiscoverBenchArgs) -> Result<(), LabError> {
-    let list = trials(&TrialCounts {
-        per_effect: a.per_effect,
-        nothing: a.nothing,
-        pairs: a.pairs,
-        collinear: a.collinear,
-        coloured: a.coloured,
-        bias_thermal: a.bias_thermal,
-        decaying: a.decaying,
-        outside: a.outside,
-        weak: a.weak,
-        seed: a.seed.seed,
-    });
-    let bar = progress_bar(
-        list.len() as u64,
-        "{bar:40} {pos}/{len} trials {eta}",
-        a.json.json,
-    );
-    let outcomes = run_all(&list, || bar.inc(1));
-    bar.finish_and_clear();
-    let s = summarize(&outcomes);
-    if !a.json.json {
-        print_discover(&s, outcomes.len());
-    }
-    println!(
-        "{}",
-        serde_json::json!({
-            "trials": outcomes.len(),
-            "right": s.total.right,
-            "false_names": s.total.false_names,
-            "gap_grew": s.total.gap_grew,
-            "intervals": s.total.intervals,
-            "covered": s.total.covered,
-            "coverage_pct": s.total.coverage_pct(),
-            "categories": s.categories,
-            "confusion": s.confusion,
-            "outcomes": outcomes,
-        })
-    );
-    Ok(())
-}
-
-#[derive(Args, Debug, Clone)]
-pub struct HeldOutBenchArgs {
-    /// The directory `simulate heldout` wrote (runs and truth.json).
-    #[arg(long)]
-    pub runs: std::path::PathBuf,
-    /// Score the JSON another `discover` printed, one `<run>.json` per run
-    /// here (its last line), instead of running this one.
-    #[arg(long)]
-    pub results: Option<std::path::PathBuf>,
-    #[command(flatten)]
-    pub json: Json,
-}
-
-fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
-    use crate::bench::discover_heldout::{score, totals, Truth};
-    use crate::model::discovery::discover as run_discover;
-    use crate::model::gyro_kind::GyroKind;
-    use crate::model::gyro_model::Model;
-    let tp = a.runs.join("truth.json");
-    let text = std::fs::read_to_string(&tp)
-        .map_err(|e| LabError::input(&tp, format!("cannot read: {e}")))?;
-    let truth: Vec<Truth> =
-        serde_json::from_str(&text).map_err(|e| LabError::input(&tp, e.to_string()))?;
-    let bar = progress_bar(
-        truth.len() as u64,
-        "{bar:40} {pos}/{len} runs {eta}",
-        a.json.json,
-    );
-    let mut scored = vec![];
-    for t in &truth {
-        let csv = a.runs.join(&t.file);
-        let r = match &a.results {
-            Some(dir) => {
-                let p = dir.join(t.file.replace(".csv", ".json"));
-                let s = std::fs::read_to_string(&p)
-                    .map_err(|e| LabError::input(&p, format!("cannot read: {e}")))?;
-                serde_json::from_str(s.lines().last().unwrap_or("{}"))
-                    .map_err(|e| LabError::input(&p, e.to_string()))?
-            }
-            None => {
-                let run = crate::cli::discover::read_run(&csv)?;
-                let g = GyroKind::from_name(&t.gyro).unwrap_or(GyroKind::Fog);
-                crate::cli::discover::json(&run_discover(
-                    &Model::ideal(g),
-                    &run,
-                    &Default::default(),
-                ))
-            }
-        };
-        scored.push(score(t, &r));
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    let tot = totals(&scored);
-    if !a.json.json {
-        println!(
-            "discovery on the held-out set of {} ({} runs)",
-            a.runs.display(),
-            scored.len()
-        );
-        for s in &scored {
-            let mark = if s.right { "right" } else { "WRONG" };
-            let miss: Vec<String> = s
-                .missed
-                .iter()
-                .map(|(e, p, v, lo, hi)| format!("{e}.{p} {v:.4e} outside [{lo:.4e}, {hi:.4e}]"))
-                .collect();
-            println!(
-                "  {:<5} {:<34} expect [{}] named [{}]{}{}{}",
-                mark,
-                s.name,
-                s.expect.join(", "),
-                s.named.join(", "),
-                if s.ambiguous.is_empty() {
-                    String::new()
-                } else {
-                    format!(" ambiguous {:?}", s.ambiguous)
-                },
-                if s.unexplained { " unexplained" } else { "" },
-                if miss.is_empty() {
-                    String::new()
-                } else {
-                    format!("; missed: {}", miss.join("; "))
-                }
-            );
-        }
-        println!(
-            "{:<36} {:>5} {:>6} {:>6} {:>9} {:>11} {:>12}",
-            "category", "runs", "right", "false", "gap grew", "unexplained", "coverage"
-        );
-        for (k, t) in &tot {
-            println!(
-                "{:<36} {:>5} {:>6} {:>6} {:>9} {:>11} {:>5}/{:<3} {:>5.1} %",
-                k,
-                t.runs,
-                t.right,
-                t.false_names,
-                t.gap_grew,
-                t.unexplained,
-                t.covered,
-                t.intervals,
-                100.0 * t.covered as f64 / t.intervals.max(1) as f64
-            );
-        }
-    }
-    println!("{}", serde_json::json!({"totals": tot, "runs": scored}));
     Ok(())
 }

@@ -17,7 +17,7 @@
 //! | vibration_rectification | c eps^2/3600 (eps the angular acceleration, deg/s^2; docs/fog.md) | ref_acc_dps2 or ref_rate_dps |
 //! | lock_in | sign(w) sqrt(w^2 - W_L^2) - w, or -w inside the lock band (docs/rlg.md) | - |
 //! | thermal_difference | k1 dT/3600, dT = t_mono_a - t_mono_b | t_mono_a_c, t_mono_b_c |
-//! | thermal_gradient | k2 d(dT)/dt /3600, the rate of dT as the least-squares slope over +-60 s | t_mono_a_c, t_mono_b_c |
+//! | thermal_gradient | k2 d(dT)/dt /3600, the rate of dT as the least-squares slope over +-60 s or more (inputs.rs: wider for coarse sensors) | t_mono_a_c, t_mono_b_c |
 //! | thermal_difference_squared | k3 dT^2/3600 | t_mono_a_c, t_mono_b_c |
 //! | case_temperature | k4 (T_K - 20)/3600 | t_case_c |
 //! | warm_up | A (1 - exp(-t/tau))/3600, t since power-on | - |

@@ -4,10 +4,45 @@
 
 use crate::numerics::thermal_difference::dt_and_gradient;
 
-/// Half width of the monoblock difference's slope, s: its sensors are
-/// read in hundredths of a degree (or sixteenths) every second or two,
-/// and its lags are thousands of seconds.
+/// Least half width of the monoblock difference's slope, s: its lags are
+/// thousands of seconds.
 pub const GRADIENT_HALF_WIDTH_S: f64 = 60.0;
+/// Most half width, s.
+pub const GRADIENT_HALF_WIDTH_MAX_S: f64 = 900.0;
+
+/// The resolution of a sensor's readings: the smallest step between
+/// neighbours (0 where it never steps).
+pub fn resolution(x: &[f64]) -> f64 {
+    x.windows(2)
+        .map(|p| (p[1] - p[0]).abs())
+        .filter(|d| *d > 1e-9)
+        .fold(f64::INFINITY, f64::min)
+        .min(1e9)
+}
+
+/// The half width of the slope of `dt` (the monoblock difference) over
+/// `t`, its sensors read to `q` degC: a sensor read in tenths of a degree
+/// turns a difference moving at 1e-3 degC/s into a staircase of 100 s
+/// treads, and the slope of a step inside the window errs by about
+/// 1.5 q/(2 h), as much as the rate itself over a minute. The half width
+/// keeps that below a tenth of the difference's own typical rate (taken
+/// over the longest half width), within [`GRADIENT_HALF_WIDTH_S`] ..
+/// [`GRADIENT_HALF_WIDTH_MAX_S`] and a twentieth of the record.
+pub fn gradient_half_width(t: &[f64], dt: &[f64], q: f64) -> f64 {
+    let span = t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0);
+    let hi = GRADIENT_HALF_WIDTH_MAX_S
+        .min(span / 20.0)
+        .max(GRADIENT_HALF_WIDTH_S);
+    if !(q.is_finite() && q > 0.0) || t.len() < 3 {
+        return GRADIENT_HALF_WIDTH_S;
+    }
+    let rough = centered_slope(t, dt, hi);
+    let rms = (rough.iter().map(|v| v * v).sum::<f64>() / rough.len() as f64).sqrt();
+    if rms <= 0.0 {
+        return hi;
+    }
+    (7.5 * q / rms).clamp(GRADIENT_HALF_WIDTH_S, hi)
+}
 
 /// Half width of the temperature rate's slope, s: wide enough to average
 /// a sensor's quantization and noise, short against a coil's thermal lag
@@ -64,7 +99,7 @@ pub struct Inputs {
     pub temp: Option<Vec<f64>>,
     pub temp_rate: Option<Vec<f64>>,
     /// Monoblock difference dT (clamped to +-32 degC as the firmware does)
-    /// and its rate (the least-squares slope over [`GRADIENT_HALF_WIDTH_S`]
+    /// and its rate (the least-squares slope over [`gradient_half_width`]
     /// either side), degC and degC/s.
     pub dt: Option<Vec<f64>>,
     pub grad: Option<Vec<f64>>,
@@ -89,7 +124,8 @@ impl Inputs {
         let (dt, grad) = match mono {
             Some((a, b)) => {
                 let (d, _) = dt_and_gradient(&t, &a, &b);
-                let g = centered_slope(&t, &d, GRADIENT_HALF_WIDTH_S);
+                let h = gradient_half_width(&t, &d, resolution(&a).max(resolution(&b)));
+                let g = centered_slope(&t, &d, h);
                 (Some(d), Some(g))
             }
             None => (None, None),

@@ -4,7 +4,8 @@
 //! RLG fringes near lock-in (fringe.rs), a gyro model with the project's
 //! noise (model_run.rs), records of known noise terms (noise_run.rs, and
 //! by other algorithms independent_noise.rs), a second generator written
-//! apart from the project's for discovery's held-out set (heldout_run.rs)
+//! apart from the project's for discovery's held-out set (heldout_run/),
+//! a third written apart from both (third_run/)
 //! and the byte stream a board sends (board_stream.rs).
 
 pub mod board_stream;
@@ -16,3 +17,4 @@ pub mod independent_noise;
 pub mod model_run;
 pub mod noise_run;
 pub mod scale_factor_rig;
+pub mod third_run;

@@ -2,6 +2,7 @@
 //! discovery (model/discovery/), and writes what it found: the model with
 //! the effects added, residual.csv, the report and the JSON.
 
+pub mod bench;
 pub mod report;
 
 use crate::cli::args::{Json, Out};
@@ -273,7 +274,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
 
 /// Whether the model written predicts another run of the same gyro: there
 /// it needs nothing more than a bias, and leaves nothing unexplained.
-fn predicts(v: &Discovery) -> bool {
+pub fn predicts(v: &Discovery) -> bool {
     v.found.iter().all(|e| e.effect == Effect::Bias) && v.unexplained.is_none()
 }
 

@@ -1,18 +1,33 @@
-//! `gyro-lab simulate heldout`: the second, independent generator's
-//! held-out set (sim/heldout_run.rs) as run files and their truth:
+//! `gyro-lab simulate heldout`: an independent generator's held-out set
+//! (`--generator second`, sim/heldout_run/, the default; `--generator
+//! third`, sim/third_run/) as run files and their truth:
 //! `DIR/NN-name.csv` and `DIR/truth.json` (per run: file, category, gyro,
 //! the names a right answer holds, the truth in the library's terms, the
-//! disturbances outside the library, the noise).
+//! disturbances outside the library, the noise; from the third, the
+//! grade, and for MEMS runs `validate`, a second day of the same gyro
+//! written beside it).
 
 use crate::cli::args::{Json, Out, Seed};
 use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
 use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
 use crate::sim::heldout_run::{held_out, HeldOutRun};
-use clap::Args;
+use crate::sim::third_run::third_set;
+use clap::{Args, ValueEnum};
+
+/// Which independent generator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Generator {
+    /// The second generator (issue 22).
+    Second,
+    /// The third, written apart from both (issue 31).
+    Third,
+}
 
 #[derive(Args, Debug, Clone)]
 pub struct HeldOutArgs {
+    #[arg(long, value_enum, default_value = "second")]
+    pub generator: Generator,
     #[command(flatten)]
     pub seed: Seed,
     /// Directory for the runs and truth.json.
@@ -72,12 +87,21 @@ fn write_run(r: &HeldOutRun, path: &std::path::Path) -> Result<(), LabError> {
 pub fn run(a: &HeldOutArgs) -> Result<(), LabError> {
     let dir = &a.out.out;
     std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
-    let runs = held_out(a.seed.seed);
+    let runs: Vec<(HeldOutRun, Option<&str>, Option<HeldOutRun>)> = match a.generator {
+        Generator::Second => held_out(a.seed.seed)
+            .into_iter()
+            .map(|r| (r, None, None))
+            .collect(),
+        Generator::Third => third_set(a.seed.seed)
+            .into_iter()
+            .map(|r| (r.run, Some(r.grade), r.day2))
+            .collect(),
+    };
     let mut truth = vec![];
-    for (i, r) in runs.iter().enumerate() {
+    for (i, (r, grade, day2)) in runs.iter().enumerate() {
         let file = format!("{:02}-{}.csv", i + 1, r.name.replace('+', "_"));
         write_run(r, &dir.join(&file))?;
-        truth.push(serde_json::json!({
+        let mut j = serde_json::json!({
             "file": file,
             "name": r.name,
             "category": r.category,
@@ -86,7 +110,17 @@ pub fn run(a: &HeldOutArgs) -> Result<(), LabError> {
             "truth": r.truth,
             "outside": r.outside,
             "noise": r.noise,
-        }));
+        });
+        if let Some(g) = grade {
+            j["grade"] = (*g).into();
+        }
+        if let Some(d2) = day2 {
+            let f2 = format!("{:02}-{}.csv", i + 1, d2.name.replace('+', "_"));
+            write_run(d2, &dir.join(&f2))?;
+            j["validate"] = f2.into();
+            j["validate_truth"] = serde_json::to_value(&d2.truth).unwrap_or_default();
+        }
+        truth.push(j);
     }
     let path = dir.join("truth.json");
     let text = serde_json::to_string_pretty(&truth).map_err(|e| LabError::io(&path, e))?;

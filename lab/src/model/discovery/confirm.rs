@@ -19,7 +19,8 @@
 //! selection run again without it.
 
 use super::design::Design;
-use super::noise_model::{profile, NoiseModel};
+use super::likelihood::{profile, Problem};
+use super::noise_model::NoiseModel;
 use super::select::{Selection, THRESHOLD};
 use super::terms::{without, Kind, Term};
 use crate::model::effects::Effect;
@@ -44,7 +45,7 @@ pub fn gain(d: &Design, terms: &[Term], j: usize, noise: &NoiseModel, full: f64)
 /// by maximum likelihood from `noise`.
 pub fn loglik(d: &Design, terms: &[Term], noise: &NoiseModel) -> f64 {
     let (cols, y) = d.raw_problem(terms);
-    profile(noise, d.win, &d.wh.keep, &y, &cols, false).1
+    profile(noise, &Problem::new(d.win, &d.wh.keep, &y, &cols), false).1
 }
 
 /// The named effect the fit needs least once the noise is re-fitted

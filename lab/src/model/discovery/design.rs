@@ -7,13 +7,16 @@
 
 use super::noise_model::Whitener;
 use super::normal::normal_solve;
-use super::terms::{Kind, Shape, Term};
+use super::projection::Projection;
+use super::terms::{without, Kind, Shape, Term};
 use super::windows::Windows;
 use crate::model::effects::{Effect, DPH};
 use crate::model::inputs::Inputs;
 use crate::model::ranges::Extent;
 use crate::numerics::search::{golden, grid_then_golden};
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
+use std::rc::Rc;
 
 /// A term's columns (window means) and fixed part, unwhitened.
 pub struct Raw {
@@ -42,6 +45,38 @@ pub struct Design<'a> {
     pub min_scale: f64,
     /// Whitened columns of the terms without a non-linear parameter.
     fixed: HashMap<String, Whitened>,
+    /// Whitened columns of terms at the points of their parameter's grid,
+    /// computed once (the searches come back to them at every step), and
+    /// the bytes they hold (at most [`GRID_CACHE_BYTES`]).
+    grid_cache: RefCell<HashMap<(String, u64), Rc<Whitened>>>,
+    grid_bytes: Cell<usize>,
+}
+
+/// Memory the grid's whitened columns may take.
+const GRID_CACHE_BYTES: usize = 256 << 20;
+
+/// Golden-section steps of a search: after the grid, the bracket shrinks
+/// to 0.618^20 (7e-5) of two grid steps; the local refinement after
+/// every addition goes to 0.618^30 (5e-7) of its bracket (a lock-in rate
+/// is set to a few ppm by a strong signal).
+const GOLDEN_STEPS: usize = 20;
+const REFINE_STEPS: usize = 30;
+
+/// A term's whitened columns, held or computed.
+enum WRef<'a> {
+    Held(&'a Whitened),
+    Shared(Rc<Whitened>),
+    Owned(Whitened),
+}
+
+impl WRef<'_> {
+    fn get(&self) -> &Whitened {
+        match self {
+            WRef::Held(w) => w,
+            WRef::Shared(w) => w,
+            WRef::Owned(w) => w,
+        }
+    }
 }
 
 /// A term's whitened columns, and its whitened derivative column when it
@@ -82,6 +117,8 @@ impl<'a> Design<'a> {
             phi: 1.0,
             min_scale: 0.0,
             fixed: HashMap::new(),
+            grid_cache: RefCell::new(HashMap::new()),
+            grid_bytes: Cell::new(0),
         };
         let mut kinds = vec![Kind::Constant];
         kinds.extend(
@@ -167,11 +204,42 @@ impl<'a> Design<'a> {
     }
 
     /// A term's whitened columns and fixed part.
-    fn whitened(&self, t: &Term) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
+    fn whitened(&self, t: &Term) -> WRef<'_> {
         if let Some(w) = self.fixed.get(&key(t.kind)) {
-            return w.clone();
+            return WRef::Held(w);
         }
-        self.whiten_raw(&self.raw(t))
+        WRef::Owned(self.whiten_raw(&self.raw(t)))
+    }
+
+    /// [`Self::whitened`] at a point of the term's grid: kept for the
+    /// next search while memory allows.
+    fn whitened_on_grid(&self, t: &Term) -> WRef<'_> {
+        let k = (key(t.kind), t.x.to_bits());
+        if let Some(w) = self.grid_cache.borrow().get(&k) {
+            return WRef::Shared(w.clone());
+        }
+        let w = self.whiten_raw(&self.raw(t));
+        let bytes =
+            8 * (w.0.iter().map(Vec::len).sum::<usize>() + w.1.as_ref().map_or(0, Vec::len));
+        if self.grid_bytes.get() + bytes > GRID_CACHE_BYTES {
+            return WRef::Owned(w);
+        }
+        self.grid_bytes.set(self.grid_bytes.get() + bytes);
+        let w = Rc::new(w);
+        self.grid_cache.borrow_mut().insert(k, w.clone());
+        WRef::Shared(w)
+    }
+
+    /// The fixed part of the searches of `terms[j]`'s parameter.
+    fn projection_without(&self, terms: &[Term], j: usize) -> Option<Projection> {
+        let (cols, y) = self.whitened_problem(&without(terms, j));
+        Projection::new(cols, y)
+    }
+
+    /// The whitened sum of squares of `proj`'s terms with `t` added.
+    fn sse_adding(&self, proj: &Projection, w: &WRef) -> f64 {
+        let (cols, off) = w.get();
+        proj.sse_with(cols, off.as_deref())
     }
 
     /// The raw (unwhitened) columns of `terms` and the residual's window
@@ -197,13 +265,14 @@ impl<'a> Design<'a> {
         let mut y = self.y.clone();
         let mut cols: Vec<Vec<f64>> = vec![];
         for t in terms {
-            let (c, o) = self.whitened(t);
+            let w = self.whitened(t);
+            let (c, o) = w.get();
             if let Some(o) = o {
                 for (a, b) in y.iter_mut().zip(o) {
                     *a -= b;
                 }
             }
-            cols.extend(c);
+            cols.extend(c.iter().cloned());
         }
         (cols, y)
     }
@@ -261,18 +330,36 @@ impl<'a> Design<'a> {
         if grid.is_empty() {
             return;
         }
-        let mut ts = terms.to_vec();
+        let Some(proj) = self.projection_without(terms, j) else {
+            return;
+        };
+        let on_grid: Vec<u64> = grid.iter().map(|x| x.to_bits()).collect();
+        let mut t = terms[j];
         let cost = |v: f64| {
-            ts[j].x = if log { v.exp() } else { v };
-            self.sse(&ts)
+            t.x = if log { v.exp() } else { v };
+            // The grid's points exactly (ln then exp may not round-trip).
+            if let Some(i) = on_grid
+                .iter()
+                .position(|b| (f64::from_bits(*b) - t.x).abs() <= 1e-12 * t.x.abs().max(1.0))
+            {
+                t.x = f64::from_bits(on_grid[i]);
+                return self.sse_adding(&proj, &self.whitened_on_grid(&t));
+            }
+            self.sse_adding(&proj, &self.whitened(&t))
         };
         let g: Vec<f64> = if log {
             grid.iter().map(|x| x.ln()).collect()
         } else {
-            grid
+            grid.clone()
         };
-        let (v, _) = grid_then_golden(cost, &g, 30);
+        let (v, _) = grid_then_golden(cost, &g, GOLDEN_STEPS);
         terms[j].x = if log { v.exp() } else { v };
+        if let Some(x) = grid
+            .iter()
+            .find(|x| (*x - terms[j].x).abs() <= 1e-12 * x.abs().max(1.0))
+        {
+            terms[j].x = *x;
+        }
     }
 
     /// Local re-fit of `terms[j]`'s non-linear parameter around its value.
@@ -292,15 +379,18 @@ impl<'a> Design<'a> {
         } else {
             ((x0 - 1.0).max(lo), (x0 + 1.0).min(hi))
         };
-        let mut ts = terms.to_vec();
+        let Some(proj) = self.projection_without(terms, j) else {
+            return;
+        };
+        let mut t = terms[j];
         let (v, _) = golden(
             |v: f64| {
-                ts[j].x = if log { v.exp() } else { v };
-                self.sse(&ts)
+                t.x = if log { v.exp() } else { v };
+                self.sse_adding(&proj, &self.whitened(&t))
             },
             a,
             b,
-            25,
+            REFINE_STEPS,
         );
         terms[j].x = if log { v.exp() } else { v };
     }

@@ -22,9 +22,11 @@ pub mod confirm;
 pub mod constant;
 pub mod design;
 pub mod estimates;
+pub mod likelihood;
 pub mod noise_floor;
 pub mod noise_model;
 pub mod normal;
+pub mod projection;
 pub mod select;
 pub mod terms;
 pub mod transients;
@@ -260,6 +262,7 @@ fn passes<'a>(
         vec![],
     );
     let sel1 = select(&d1, cands);
+    debug_pass("1", &sel1, &NoiseModel::white_of(rw, &all));
     let e1 = left(&d1, &sel1.terms());
     let tr = transients::find(win, &e1);
     let keep = tr.keep(n);
@@ -281,13 +284,14 @@ fn passes<'a>(
     };
     let d2 = design(&noise_a);
     let sel2 = select(&d2, cands);
+    debug_pass("2", &sel2, &noise_a);
     // The noise's slow levels by maximum likelihood given what the second
     // pass selected, then the selection again on that noise (weighing the
     // criterion by the correlation its whitened residual still holds);
     // once more if the noise and the names still moved.
     let ml = |d: &Design, sel: &Selection, start: &NoiseModel| {
         let (cols, y) = d.raw_problem(&sel.terms());
-        noise_model::refine(start, win, &keep, &y, &cols)
+        likelihood::refine(start, &likelihood::Problem::new(win, &keep, &y, &cols))
     };
     let mut noise = ml(&d2, &sel2, &noise_a);
     let mut names = sel2.named_effects();
@@ -298,6 +302,7 @@ fn passes<'a>(
         let mut d = design(&noise);
         d.phi = d.fit(&prev).map_or(1.0, |f| inflation(&f.resid, &keep));
         let sel = select(&d, cands);
+        debug_pass(&pass.to_string(), &sel, &noise);
         let now = sel.named_effects();
         if now == names || pass >= MAX_PASSES {
             return (d, sel, noise, tr, pass);
@@ -306,6 +311,27 @@ fn passes<'a>(
         prev = sel.terms();
         noise = ml(&d, &sel, &noise);
     }
+}
+
+/// With GYRO_LAB_DEBUG set: a pass's terms and noise, on stderr.
+fn debug_pass(pass: &str, sel: &Selection, noise: &NoiseModel) {
+    if std::env::var_os("GYRO_LAB_DEBUG").is_none() {
+        return;
+    }
+    let terms: Vec<String> = sel
+        .terms()
+        .iter()
+        .map(|t| format!("{}@{:.4}", t.kind.describe(), t.x))
+        .collect();
+    eprintln!(
+        "pass {pass}: [{}] white {:.4} dph, flicker {:.4} dph, rw {:.4} dph/sqrt(h), markov {:.4} dph over {:.0} s",
+        terms.join(", "),
+        noise.white.sqrt() * 3600.0,
+        noise.flicker.sqrt() * 3600.0,
+        noise.random_walk.sqrt() * 3600.0 * 60.0,
+        noise.markov.sqrt() * 3600.0,
+        noise.markov_s
+    );
 }
 
 /// What a short record's intervals rest on, said plainly (None for a
@@ -325,14 +351,15 @@ fn short_record(d: &Design, sel: &Selection) -> Option<String> {
 
 /// The intervals widened for the slow noise the record cannot exclude:
 /// the flicker and the random walk the restricted likelihood still allows
-/// at 95 % (noise_model.rs's `slow_bounds`), each in turn, the final terms
+/// at 95 % (likelihood.rs's `slow_bounds`), each in turn, the final terms
 /// refitted on the problem whitened by it. A slow level fitted as nothing
 /// (white noise hides a bias instability at every averaging time the Allan
 /// curve measures well) otherwise leaves a slow regressor's interval
 /// that of white noise.
 fn allow_slow_noise(d: &Design, terms: &[Term], noise: &NoiseModel, fin: &mut estimates::Final) {
     let (cols, y) = d.raw_problem(terms);
-    for up in noise_model::slow_bounds(noise, d.win, &d.wh.keep, &y, &cols) {
+    let p = likelihood::Problem::new(d.win, &d.wh.keep, &y, &cols);
+    for up in likelihood::slow_bounds(noise, &p) {
         if up == *noise {
             continue;
         }

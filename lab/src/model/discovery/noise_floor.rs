@@ -16,6 +16,34 @@ pub struct Disagreement {
     pub peak_dph: f64,
 }
 
+/// Share of exactly equal neighbours beyond which a series is read as
+/// quantised at the level of its own noise.
+const QUANTISED_SHARE: f64 = 0.2;
+
+/// The variance of one value of a series of white noise from its
+/// neighbours' squared differences `d2`: robustly, half their median over
+/// chi-square(1)'s (slow effects and a few steps are differenced away);
+/// but where a fifth or more of the neighbours are exactly equal (an RLG's
+/// angle counts, a MEMS gyro's word: the output quantised as coarsely as
+/// its noise) the median is no measure (it reads zero) and the mean of the
+/// squares is taken, its largest 1 % left out, over the share of a
+/// Gaussian's mean below its 99 % quantile (P(chi2_3 < 6.635)/0.99): the
+/// quantisation is part of the floor. None for fewer than two.
+pub fn white_var_of_diffs(d2: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = d2.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.len() < 2 {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let zeros = v.iter().filter(|x| **x == 0.0).count() as f64 / v.len() as f64;
+    if zeros < QUANTISED_SHARE {
+        return Some(v[v.len() / 2] / (2.0 * 0.454_936));
+    }
+    let kept = &v[..((v.len() as f64 * 0.99).ceil() as usize).max(1)];
+    let ms = kept.iter().sum::<f64>() / kept.len() as f64;
+    Some(ms / (2.0 * 0.915_508 / 0.99))
+}
+
 /// RMS of the window means of `r` (deg/s) in deg/h.
 pub fn gap(win: &Windows, r: &[f64]) -> f64 {
     let m = win.mean(r);
@@ -45,9 +73,8 @@ fn noise_at(a: Option<&Allan>, t: &[f64], r: &[f64], tau: f64) -> f64 {
             return v.sqrt() * 3600.0;
         }
     }
-    let mut d: Vec<f64> = r.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-    d.sort_by(f64::total_cmp);
-    let sigma = d.get(d.len() / 2).copied().unwrap_or(0.0) * 1.4826 / 2f64.sqrt();
+    let d2: Vec<f64> = r.windows(2).map(|w| (w[1] - w[0]).powi(2)).collect();
+    let sigma = white_var_of_diffs(&d2).unwrap_or(0.0).sqrt();
     let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64;
     sigma * (dt / tau).min(1.0).sqrt() * 3600.0
 }
@@ -68,12 +95,8 @@ pub fn noise_floor(
 ) -> f64 {
     let model_floor = noise_at(allan, t, r, window_s);
     let means = win.mean(r);
-    let mut d2: Vec<f64> = means.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
-    d2.sort_by(f64::total_cmp);
-    // Median of chi-square with one degree of freedom: 0.4549.
-    let measured = d2
-        .get(d2.len() / 2)
-        .map_or(f64::INFINITY, |m| (m / (2.0 * 0.454_936)).sqrt() * 3600.0);
+    let d2: Vec<f64> = means.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
+    let measured = white_var_of_diffs(&d2).map_or(f64::INFINITY, |v| v.sqrt() * 3600.0);
     if d2.len() >= 10 {
         measured.min(model_floor)
     } else {

@@ -21,7 +21,7 @@
 //! The terms are fitted to the residual's Allan variance here
 //! ([`fit_terms`], on the noise analysis's estimator), every term kept;
 //! then, given the terms of a selection, the random walk, flicker and
-//! Markov levels are refined by maximum likelihood ([`refine`]): the
+//! Markov levels are refined by maximum likelihood (likelihood.rs): the
 //! innovations' likelihood weighs the slowest frequencies, where the
 //! Allan curve has the fewest estimates.
 //!
@@ -71,11 +71,9 @@ impl NoiseModel {
             .filter(|(_, k)| **k)
             .map(|(v, _)| *v)
             .collect();
-        let mut d2: Vec<f64> = m.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
-        d2.sort_by(f64::total_cmp);
-        let white = d2
-            .get(d2.len() / 2)
-            .map_or(1e-12, |v| v / (2.0 * 0.454_936))
+        let d2: Vec<f64> = m.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
+        let white = super::noise_floor::white_var_of_diffs(&d2)
+            .unwrap_or(1e-12)
             .max(1e-30);
         Self {
             white,
@@ -270,184 +268,6 @@ pub fn fit_terms(
     best
 }
 
-/// The restricted log-likelihood of noise model `m` for the residual
-/// less fixed parts `y` and a fit's raw columns `cols` (window means), the
-/// white level profiled out as the common scale.
-fn reml(m: &NoiseModel, win: &Windows, keep: &[bool], y: &[f64], cols: &[Vec<f64>]) -> f64 {
-    loglik(m, win, keep, y, cols, true)
-}
-
-/// The log-likelihood of noise model `m` for `y` less the fit of `cols`:
-/// restricted ([`reml`]) or plain maximum likelihood (n in place of n - p,
-/// no Gram determinant: the one that compares fits of different columns).
-fn loglik(
-    m: &NoiseModel,
-    win: &Windows,
-    keep: &[bool],
-    y: &[f64],
-    cols: &[Vec<f64>],
-    restricted: bool,
-) -> f64 {
-    let w = Whitener::new(m, win, keep);
-    let yw = w.whiten(y);
-    let cw: Vec<Vec<f64>> = cols.iter().map(|c| w.whiten(c)).collect();
-    let sse = match super::normal::normal_solve(&cw, &yw) {
-        Some(b) if !cw.is_empty() => {
-            let mut r = yw.clone();
-            for (c, bj) in cw.iter().zip(&b) {
-                for (a, v) in r.iter_mut().zip(c) {
-                    *a -= bj * v;
-                }
-            }
-            r.iter().map(|v| v * v).sum::<f64>()
-        }
-        _ => yw.iter().map(|v| v * v).sum::<f64>(),
-    };
-    // The restricted likelihood (REML): the fit's p columns take p
-    // degrees of freedom of the residual, and their Gram determinant
-    // weighs how much of each slow noise level they can absorb. Plain
-    // maximum likelihood (n in place of n - p, no determinant) reads the
-    // slow noise the fitted shapes soaked up as absent, and the slow
-    // levels, and with them the intervals, came out too small.
-    let n = w.used() as f64;
-    if !restricted {
-        return -0.5 * (n * (sse / n.max(1.0)).max(1e-300).ln() + w.log_det());
-    }
-    let p = cw.len() as f64;
-    let gram = if cw.is_empty() {
-        Some(0.0)
-    } else {
-        gram_log_det(&cw)
-    };
-    let Some(gram) = gram else {
-        return f64::NEG_INFINITY;
-    };
-    let m = (n - p).max(1.0);
-    -0.5 * (m * (sse / m).max(1e-300).ln() + w.log_det() + gram)
-}
-
-/// Half the chi-square(1) 95 % quantile: the fall of the log-likelihood
-/// at a level's 95 % profile bound.
-const HALF_CHI2_1_95: f64 = 1.920_729_410_347_062;
-
-/// The noise model with, in turn, its flicker and its random walk raised
-/// to the largest level the record cannot exclude (restricted likelihood
-/// within [`HALF_CHI2_1_95`] of `m`'s, the level scanned up in eighths of
-/// a decade from `m`'s, or a ten-thousandth of the white level, to a
-/// thousand times that): the slow noise a fit's intervals must allow for
-/// when the Allan curve and the likelihood cannot tell it from none.
-pub fn slow_bounds(
-    m: &NoiseModel,
-    win: &Windows,
-    keep: &[bool],
-    y: &[f64],
-    cols: &[Vec<f64>],
-) -> Vec<NoiseModel> {
-    let l0 = reml(m, win, keep, y, cols);
-    let floor = m.white * 1e-4;
-    (0..2)
-        .map(|which| {
-            let base = if which == 0 {
-                m.flicker.max(floor)
-            } else {
-                m.random_walk.max(floor * 1e-3)
-            };
-            let mut best = l0;
-            let mut up = *m;
-            for k in 1..=24 {
-                let mut c = *m;
-                let v = base * 10f64.powf(0.125 * k as f64);
-                if which == 0 {
-                    c.flicker = v;
-                } else {
-                    c.random_walk = v;
-                }
-                let l = reml(&c, win, keep, y, cols);
-                best = best.max(l);
-                if l < best - HALF_CHI2_1_95 {
-                    break;
-                }
-                up = c;
-            }
-            up
-        })
-        .collect()
-}
-
-/// The noise model, given the terms of a fit (their raw columns `cols`
-/// and the residual less their fixed parts `y`, window means), with its
-/// random walk, flicker and Markov levels refined by restricted maximum
-/// likelihood (REML: the likelihood of the residual's contrasts the fit's
-/// columns leave; each scaled by a factor searched over 1/100 .. 100 and zero, in turn,
-/// twice; the white level profiled out as the common scale).
-pub fn refine(
-    start: &NoiseModel,
-    win: &Windows,
-    keep: &[bool],
-    y: &[f64],
-    cols: &[Vec<f64>],
-) -> NoiseModel {
-    profile(start, win, keep, y, cols, true).0
-}
-
-/// The noise model searched as [`refine`] does, by the restricted or the
-/// plain likelihood, and that likelihood at its best.
-pub fn profile(
-    start: &NoiseModel,
-    win: &Windows,
-    keep: &[bool],
-    y: &[f64],
-    cols: &[Vec<f64>],
-    restricted: bool,
-) -> (NoiseModel, f64) {
-    let loglik = |m: &NoiseModel| loglik(m, win, keep, y, cols, restricted);
-    let mut m = *start;
-    let floor = m.white * 1e-4;
-    let mut best = loglik(&m);
-    let factors: Vec<f64> = std::iter::once(0.0)
-        .chain((0..=16).map(|i| 10f64.powf(-2.0 + 0.25 * i as f64)))
-        .collect();
-    for _ in 0..2 {
-        for which in 0..3 {
-            let base = match which {
-                0 => m.random_walk.max(floor * 1e-3),
-                1 => m.flicker.max(floor),
-                _ => m.markov.max(floor),
-            };
-            for &f in &factors {
-                let mut c = m;
-                match which {
-                    0 => c.random_walk = base * f,
-                    1 => c.flicker = base * f,
-                    _ => c.markov = base * f,
-                }
-                let l = loglik(&c);
-                if l > best + 1e-9 {
-                    best = l;
-                    m = c;
-                }
-            }
-        }
-    }
-    (m, best)
-}
-
-/// ln det of the Gram matrix of `cols` (None when it is singular).
-fn gram_log_det(cols: &[Vec<f64>]) -> Option<f64> {
-    let m = cols.len();
-    let g = nalgebra::DMatrix::from_fn(m, m, |i, j| {
-        cols[i]
-            .iter()
-            .zip(&cols[j])
-            .map(|(a, b)| a * b)
-            .sum::<f64>()
-    });
-    let c = g.cholesky()?;
-    let l = c.l_dirty();
-    let s: f64 = (0..m).map(|i| 2.0 * l[(i, i)].ln()).sum();
-    s.is_finite().then_some(s)
-}
-
 /// The Kalman filter's gains for a noise model over a run's windows: it
 /// turns any column of window means into its standardised innovations.
 pub struct Whitener {
@@ -463,28 +283,64 @@ pub struct Whitener {
     pub keep: Vec<bool>,
 }
 
+/// The variance of a mean over `x` correlation times of a first-order
+/// Markov process of unit variance: 2 (x - 1 + e^(-x))/x^2 (1 at x = 0).
+pub fn markov_mean_var(x: f64) -> f64 {
+    if x < 1e-4 {
+        1.0 - x / 3.0
+    } else {
+        2.0 * (x - 1.0 + (-x).exp()) / (x * x)
+    }
+}
+
+/// A correlated process faster than this many of its correlation times
+/// per observation is white there.
+const WHITE_BEYOND: f64 = 3.0;
+
 impl Whitener {
     /// The gains of `noise` over windows `win` (mid times, row counts),
     /// using the windows `keep` marks.
     pub fn new(noise: &NoiseModel, win: &Windows, keep: &[bool]) -> Self {
+        Self::averaged(noise, win, keep, 0.0)
+    }
+
+    /// [`Self::new`] for observations that are means over `block_s` s
+    /// (blocks of windows, likelihood.rs): each correlated process's
+    /// variance is that of its mean over the block, and those faster than
+    /// [`WHITE_BEYOND`] correlation times per block join the white noise.
+    /// The random walk is taken at the blocks' times (its mean over a
+    /// block differs by a third of a step, small beside the white noise of
+    /// a block wherever the walk can be told from it).
+    pub fn averaged(noise: &NoiseModel, win: &Windows, keep: &[bool], block_s: f64) -> Self {
         let n = win.len();
         let span = if n > 1 { win.t[n - 1] - win.t[0] } else { 1.0 };
-        let mut taus: Vec<f64> = vec![];
+        let mut comps: Vec<(f64, f64)> = vec![];
         if noise.flicker > 0.0 {
+            let var_fl = noise.flicker * FLICKER_SPACING.ln() / std::f64::consts::PI;
             let mut tc = FLICKER_MIN_S;
             while tc <= span.max(FLICKER_MIN_S) * FLICKER_SPACING {
-                taus.push(tc);
+                comps.push((tc, var_fl));
                 tc *= FLICKER_SPACING;
             }
         }
-        let var_fl = noise.flicker * FLICKER_SPACING.ln() / std::f64::consts::PI;
         // The Markov process last, its own variance.
-        let mk = noise.markov > 0.0;
-        let mut vars = vec![var_fl; taus.len()];
-        if mk {
-            taus.push(noise.markov_s.max(1e-6));
-            vars.push(noise.markov);
+        if noise.markov > 0.0 {
+            comps.push((noise.markov_s.max(1e-6), noise.markov));
         }
+        let mut taus: Vec<f64> = vec![];
+        let mut vars: Vec<f64> = vec![];
+        let mut white_extra = 0.0;
+        for (tc, v) in comps {
+            let x = block_s / tc;
+            let v = v * markov_mean_var(x);
+            if x > WHITE_BEYOND {
+                white_extra += v;
+            } else {
+                taus.push(tc);
+                vars.push(v);
+            }
+        }
+        let white = noise.white + white_extra;
         let s = 1 + taus.len();
         let mut counts: Vec<f64> = win.count.clone();
         counts.sort_by(f64::total_cmp);
@@ -522,7 +378,7 @@ impl Whitener {
             }
             // Observation: the sum of the states plus white noise.
             let ph1: Vec<f64> = (0..s).map(|i| (0..s).map(|j| p[i * s + j]).sum()).collect();
-            let f = ph1.iter().sum::<f64>() + noise.white * nominal / win.count[k].max(1e-9);
+            let f = ph1.iter().sum::<f64>() + white * nominal / win.count[k].max(1e-9);
             if f <= 0.0 || !f.is_finite() {
                 continue;
             }

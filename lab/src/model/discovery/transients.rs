@@ -46,11 +46,13 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-/// Robust white scatter of a window mean: the neighbour differences' median
-/// absolute value.
+/// Robust white scatter of a window mean, from its neighbours'
+/// differences (noise_floor.rs's `white_var_of_diffs`).
 pub fn white_sigma(e: &[f64]) -> f64 {
-    let mut d: Vec<f64> = e.windows(2).map(|p| (p[1] - p[0]).abs()).collect();
-    median(&mut d) * 1.4826 / std::f64::consts::SQRT_2
+    let d2: Vec<f64> = e.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
+    super::noise_floor::white_var_of_diffs(&d2)
+        .unwrap_or(0.0)
+        .sqrt()
 }
 
 /// The times of the `most` largest jumps of `e`'s level (the mean over
