@@ -80,6 +80,22 @@ impl Grade {
         }
     }
 
+    /// The most slow noise a gyro of the grade has: bias instability
+    /// (deg/h), rate random walk (deg/h/sqrt(h)) and a first-order Markov
+    /// wander (deg/h). Generous (ten times the grade's bias stability and
+    /// more): they only decide whether a residual wandering beyond them is
+    /// called unexplained, never what is named. A navigation gyro with a
+    /// random walk of a deg/h/sqrt(h) is a sinusoidal bias or a thermal
+    /// term the noise model swallowed (issue 31), not a noisy gyro.
+    pub fn noise_caps(self) -> (f64, f64, f64) {
+        match self {
+            Grade::Navigation => (0.1, 0.1, 0.1),
+            Grade::Tactical => (30.0, 10.0, 30.0),
+            Grade::Industrial => (300.0, 100.0, 300.0),
+            Grade::Consumer => (3000.0, 1000.0, 3000.0),
+        }
+    }
+
     /// The grade a white noise of `arw_dpsh` deg/sqrt(h) tells.
     pub fn of_white_noise(arw_dpsh: f64) -> Self {
         ARW_BOUNDS

@@ -103,6 +103,8 @@ pub struct Inputs {
     /// either side), degC and degC/s.
     pub dt: Option<Vec<f64>>,
     pub grad: Option<Vec<f64>>,
+    /// The monoblocks' mean, degC.
+    pub mono_mean: Option<Vec<f64>>,
     /// Case sensor, degC.
     pub case: Option<Vec<f64>>,
     /// Angular acceleration, deg/s^2, and whether it was derived from the
@@ -121,6 +123,9 @@ impl Inputs {
         case: Option<Vec<f64>>,
         acc: Option<Vec<f64>>,
     ) -> Self {
+        let mono_mean = mono
+            .as_ref()
+            .map(|(a, b)| a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect());
         let (dt, grad) = match mono {
             Some((a, b)) => {
                 let (d, _) = dt_and_gradient(&t, &a, &b);
@@ -155,6 +160,7 @@ impl Inputs {
             temp_rate,
             dt,
             grad,
+            mono_mean,
             case,
             acc,
             acc_derived,

@@ -12,6 +12,7 @@ use crate::data::residual_file;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
 use crate::model::discovery::estimates::Estimate;
+use crate::model::discovery::terms::Kind;
 use crate::model::discovery::{discover, Discovery, Options, Run, WINDOW_S};
 use crate::model::effects::Effect;
 use crate::model::grade::Grade;
@@ -170,6 +171,8 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "gap_before_dph": d.gap_before_dph,
         "gap_after_dph": d.gap_after_dph,
         "noise_floor_dph": d.noise_floor_dph,
+        "noise_floor_hi_dph": d.noise_floor_hi_dph,
+        "noise_floor_white_dph": d.noise_floor_white_dph,
         "ambiguous": d.ambiguous,
         "unexplained": d.unexplained,
         "carried": carried,
@@ -178,7 +181,13 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "not_confirmed": d
             .not_confirmed
             .iter()
-            .map(|(e, g)| serde_json::json!({"effect": e, "gain": g}))
+            .map(|(k, g)| {
+                let e = match k {
+                    Kind::Constant => Some(Effect::Bias),
+                    k => k.effect(),
+                };
+                serde_json::json!({"effect": e, "term": k.describe(), "gain": g})
+            })
             .collect::<Vec<_>>(),
         "skipped": skipped,
         "disagreements": d.disagreements,
@@ -428,11 +437,13 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
             g.suggestion
         );
     }
-    for (e, g) in &d.not_confirmed {
+    for (k, g) in &d.not_confirmed {
+        let what = match k {
+            Kind::Constant => "bias".to_owned(),
+            k => k.describe(),
+        };
         println!(
-            "not named {}: it paid on the selection's noise, but once the noise (random walk, flicker, Markov) is re-fitted without it, it gains only {:.1} (threshold {}): the noise imitates it",
-            e.name(),
-            g,
+            "set aside {what}: it paid on the selection's noise, but once the noise (random walk, flicker, Markov) is re-fitted without it, it gains only {g:.1} (threshold {}): the noise imitates it",
             crate::model::discovery::select::THRESHOLD
         );
     }

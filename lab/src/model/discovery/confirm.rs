@@ -9,8 +9,10 @@
 //! named on a table run that held nothing but a random walk, whose noise
 //! model, fitted with it, read a twentieth of the random walk there was.
 //!
-//! So each named effect (and the constant, before it is called a bias)
-//! must pay against the noise fitted without it: twice the log-likelihood
+//! So each named effect, each term no effect explains (issue 31: a
+//! sinusoid or a step fitted to a random walk is not what the library
+//! lacks), and the constant before it is called a bias, must pay against
+//! the noise fitted without it: twice the log-likelihood
 //! ratio of the fits with and without it, each side with its random walk,
 //! flicker and Markov levels re-fitted by maximum likelihood (plain, not
 //! restricted: the two sides have different columns), less the BIC's
@@ -23,7 +25,6 @@ use super::likelihood::{profile, Problem};
 use super::noise_model::NoiseModel;
 use super::select::{Selection, THRESHOLD};
 use super::terms::{without, Kind, Term};
-use crate::model::effects::Effect;
 
 /// Effects set aside at most (then the selection stands as it is).
 pub const MAX_SET_ASIDE: usize = 3;
@@ -48,10 +49,16 @@ pub fn loglik(d: &Design, terms: &[Term], noise: &NoiseModel) -> f64 {
     profile(noise, &Problem::new(d.win, &d.wh.keep, &y, &cols), false).1
 }
 
-/// The named effect the fit needs least once the noise is re-fitted
-/// without it, with its gain, when that gain is below [`THRESHOLD`].
-pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Effect, f64)> {
-    if sel.named.is_empty() {
+/// The named effect or term no effect explains (a shape, a step, a
+/// periodic disturbance) the fit needs least once the noise is re-fitted
+/// without it, with its gain, when that gain is below [`THRESHOLD`]. A
+/// shape the noise imitates as well is no more a structure in the residual
+/// than an effect is: a random walk's wander fitted by a sinusoid, or a
+/// flicker's by a step, is not what the library lacks; but a sinusoidal
+/// bias a nominal noise cannot make (a random walk of a deg/h/sqrt(h) on
+/// a gyro with none) pays hundreds.
+pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Kind, f64)> {
+    if sel.named.is_empty() && sel.nuisance.is_empty() {
         return None;
     }
     let terms = sel.terms();
@@ -59,8 +66,8 @@ pub fn weakest(d: &Design, sel: &Selection, noise: &NoiseModel) -> Option<(Effec
     terms
         .iter()
         .enumerate()
-        .filter(|(_, t)| sel.named.iter().any(|s| s.term == **t))
-        .filter_map(|(j, t)| Some((t.kind.effect()?, gain(d, &terms, j, noise, full))))
+        .filter(|(_, t)| sel.named.iter().any(|s| s.term == **t) || sel.nuisance.contains(t))
+        .map(|(j, t)| (t.kind, gain(d, &terms, j, noise, full)))
         .filter(|(_, g)| *g < THRESHOLD)
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }

@@ -8,7 +8,7 @@
 use super::noise_model::Whitener;
 use super::normal::normal_solve;
 use super::projection::Projection;
-use super::terms::{without, Kind, Shape, Term};
+use super::terms::{periodic_grid, without, Kind, Shape, Term};
 use super::windows::Windows;
 use crate::model::effects::{Effect, DPH};
 use crate::model::inputs::Inputs;
@@ -166,6 +166,16 @@ impl<'a> Design<'a> {
                 cols: vec![self.win.mean(&s.column(self.inp))],
                 offset: None,
             },
+            Kind::Periodic => {
+                let om = std::f64::consts::TAU / t.x.max(1e-9);
+                Raw {
+                    cols: vec![
+                        self.win.t.iter().map(|&w| DPH * (om * w).sin()).collect(),
+                        self.win.t.iter().map(|&w| DPH * (om * w).cos()).collect(),
+                    ],
+                    offset: None,
+                }
+            }
             Kind::Decay => Raw {
                 cols: vec![self
                     .win
@@ -319,6 +329,15 @@ impl<'a> Design<'a> {
     fn grid(&self, t: &Term) -> (Vec<f64>, bool) {
         match t.kind {
             Kind::Effect(e) => (e.search_grid(self.inp), e.search_log()),
+            Kind::Periodic => {
+                let n = self.win.t.len();
+                let span = if n > 1 {
+                    self.win.t[n - 1] - self.win.t[0]
+                } else {
+                    0.0
+                };
+                (periodic_grid(span), true)
+            }
             _ => (vec![], false),
         }
     }
@@ -326,6 +345,21 @@ impl<'a> Design<'a> {
     /// Best non-linear parameter of `terms[j]` with the others held: grid
     /// then golden section (in ln x for positive, decade-spanning ones).
     pub fn optimize(&self, terms: &mut [Term], j: usize) {
+        self.optimize_with(terms, j, true);
+    }
+
+    /// Whether `t` has a parameter to search.
+    pub fn searched(&self, t: &Term) -> bool {
+        !self.grid(t).0.is_empty()
+    }
+
+    /// [`Self::optimize`] on the grid alone (its whitened columns are
+    /// kept: a screening of many candidates costs their products only).
+    pub fn optimize_on_grid(&self, terms: &mut [Term], j: usize) {
+        self.optimize_with(terms, j, false);
+    }
+
+    fn optimize_with(&self, terms: &mut [Term], j: usize, golden_too: bool) {
         let (grid, log) = self.grid(&terms[j]);
         if grid.is_empty() {
             return;
@@ -352,7 +386,7 @@ impl<'a> Design<'a> {
         } else {
             grid.clone()
         };
-        let (v, _) = grid_then_golden(cost, &g, GOLDEN_STEPS);
+        let (v, _) = grid_then_golden(cost, &g, if golden_too { GOLDEN_STEPS } else { 0 });
         terms[j].x = if log { v.exp() } else { v };
         if let Some(x) = grid
             .iter()

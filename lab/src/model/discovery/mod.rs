@@ -44,7 +44,7 @@ use crate::noise::analysis::Allan;
 use constant::Role;
 use design::{inflation, Design};
 use estimates::{estimate, Estimate};
-use noise_floor::{allan_of, disagreements, gap, noise_floor, Disagreement};
+use noise_floor::{allan_of, disagreements, expected_gap, gap, noise_floor, Disagreement};
 use noise_model::{NoiseModel, Whitener, MIN_COLOUR_WINDOWS};
 use select::{select, Ambiguous, Implausible, Selection};
 use std::collections::BTreeMap;
@@ -105,17 +105,24 @@ pub struct Discovery {
     pub unexplained: Option<Unexplained>,
     /// Effects the backward steps removed after they came in.
     pub dropped: Vec<String>,
-    /// Effects (and the constant, as `bias`) that paid on the selection's
-    /// noise but not once the noise was re-fitted without them
-    /// (confirm.rs), with what they gained then (below the threshold).
-    pub not_confirmed: Vec<(Effect, f64)>,
+    /// Effects, terms no effect explains, and the constant (as
+    /// `Kind::Constant`) that paid on the selection's noise but not once
+    /// the noise was re-fitted without them (confirm.rs), with what they
+    /// gained then (below the threshold).
+    pub not_confirmed: Vec<(Kind, f64)>,
     pub skipped: Vec<Skipped>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
     pub windows: Windows,
     pub gap_before_dph: f64,
     pub gap_after_dph: f64,
+    /// The gap the noise alone leaves (noise_floor.rs's `expected_gap`,
+    /// slow levels capped at the grade's), its upper bound (slow levels at
+    /// their 95 % bounds, three standard deviations), and the white floor
+    /// of 1 s means the first pass starts from, deg/h.
     pub noise_floor_dph: f64,
+    pub noise_floor_hi_dph: f64,
+    pub noise_floor_white_dph: f64,
     pub noise: NoiseModel,
     pub passes: usize,
     /// Set when the joint fit's parameters would have widened the gap and
@@ -233,6 +240,7 @@ fn passes<'a>(
     r: &[f64],
     rw: &[f64],
     cands: &[Effect],
+    excluded: &[Kind],
     grade: Grade,
 ) -> (Design<'a>, Selection, NoiseModel, Transients, usize) {
     let n = win.len();
@@ -250,7 +258,7 @@ fn passes<'a>(
             vec![],
         );
         d.min_scale = 1.0;
-        let sel = select(&d, cands);
+        let sel = select(&d, cands, excluded);
         return (d, sel, noise, Transients::default(), 1);
     }
     let d1 = Design::new(
@@ -261,7 +269,7 @@ fn passes<'a>(
         Whitener::new(&white, win, &all),
         vec![],
     );
-    let sel1 = select(&d1, cands);
+    let sel1 = select(&d1, cands, excluded);
     debug_pass("1", &sel1, &NoiseModel::white_of(rw, &all));
     let e1 = left(&d1, &sel1.terms());
     let tr = transients::find(win, &e1);
@@ -283,7 +291,7 @@ fn passes<'a>(
         )
     };
     let d2 = design(&noise_a);
-    let sel2 = select(&d2, cands);
+    let sel2 = select(&d2, cands, excluded);
     debug_pass("2", &sel2, &noise_a);
     // The noise's slow levels by maximum likelihood given what the second
     // pass selected, then the selection again on that noise (weighing the
@@ -301,7 +309,7 @@ fn passes<'a>(
         pass += 1;
         let mut d = design(&noise);
         d.phi = d.fit(&prev).map_or(1.0, |f| inflation(&f.resid, &keep));
-        let sel = select(&d, cands);
+        let sel = select(&d, cands, excluded);
         debug_pass(&pass.to_string(), &sel, &noise);
         let now = sel.named_effects();
         if now == names || pass >= MAX_PASSES {
@@ -356,10 +364,14 @@ fn short_record(d: &Design, sel: &Selection) -> Option<String> {
 /// (white noise hides a bias instability at every averaging time the Allan
 /// curve measures well) otherwise leaves a slow regressor's interval
 /// that of white noise.
-fn allow_slow_noise(d: &Design, terms: &[Term], noise: &NoiseModel, fin: &mut estimates::Final) {
-    let (cols, y) = d.raw_problem(terms);
-    let p = likelihood::Problem::new(d.win, &d.wh.keep, &y, &cols);
-    for up in likelihood::slow_bounds(noise, &p) {
+fn allow_slow_noise(
+    d: &Design,
+    terms: &[Term],
+    noise: &NoiseModel,
+    bounds: &[NoiseModel],
+    fin: &mut estimates::Final,
+) {
+    for up in bounds.iter().copied() {
         if up == *noise {
             continue;
         }
@@ -484,16 +496,22 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     };
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
     let (cands, skipped) = candidates(model.gyro, inp);
-    // The selection, run again without any named effect the fit does not
-    // need once its noise is re-fitted without it (confirm.rs).
-    let mut not_confirmed: Vec<(Effect, f64)> = vec![];
+    // The selection, run again without any named effect or unexplained
+    // term the fit does not need once its noise is re-fitted without it
+    // (confirm.rs).
+    let mut not_confirmed: Vec<(Kind, f64)> = vec![];
     let (d, sel, noise, tr, passes) = loop {
         let now: Vec<Effect> = cands
             .iter()
             .copied()
-            .filter(|e| !not_confirmed.iter().any(|x| x.0 == *e))
+            .filter(|e| !not_confirmed.iter().any(|x| x.0 == Kind::Effect(*e)))
             .collect();
-        let out = passes(inp, &win, &r, &rw, &now, grade.value);
+        let excluded: Vec<Kind> = not_confirmed
+            .iter()
+            .map(|x| x.0)
+            .filter(|k| k.effect().is_none())
+            .collect();
+        let out = passes(inp, &win, &r, &rw, &now, &excluded, grade.value);
         if out.0.win.len() < MIN_COLOUR_WINDOWS || not_confirmed.len() >= confirm::MAX_SET_ASIDE {
             break out;
         }
@@ -507,17 +525,27 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     if role == Role::Named && short.is_none() {
         let g = confirm::constant_gain(&d, &sel, &noise);
         if g < select::THRESHOLD {
-            not_confirmed.push((Effect::Bias, g));
+            not_confirmed.push((Kind::Constant, g));
             let alone = sel.named.is_empty() && sel.carried.is_empty() && sel.nuisance.is_empty();
             role = if alone { Role::Unneeded } else { Role::Carried };
         }
     }
     let terms = sel.terms();
     let mut fin = estimate(&d, &terms);
-    if short.is_none() {
-        if let Some(f) = fin.as_mut() {
-            allow_slow_noise(&d, &terms, &noise, f);
-        }
+    // The slow noise the record cannot exclude at 95 % (likelihood.rs's
+    // slow_bounds): it widens the intervals, and it bounds the floor the
+    // gap after is judged against.
+    let bounds = if short.is_none() {
+        let (cols, y) = d.raw_problem(&terms);
+        likelihood::slow_bounds(
+            &noise,
+            &likelihood::Problem::new(&win, &d.wh.keep, &y, &cols),
+        )
+    } else {
+        vec![]
+    };
+    if let Some(f) = fin.as_mut() {
+        allow_slow_noise(&d, &terms, &noise, &bounds, f);
     }
     let est = |j: usize| -> Option<Estimate> {
         fin.as_ref()
@@ -536,7 +564,7 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
                 )),
                 Role::Named => None,
                 Role::Ambiguous => Some("the constant, for the ambiguous group it heads".into()),
-                _ if not_confirmed.iter().any(|x| x.0 == Effect::Bias) => Some(
+                _ if not_confirmed.iter().any(|x| x.0 == Kind::Constant) => Some(
                     "the constant the other terms are fitted with (not named a bias: once the noise is re-fitted without it, it gains less than the threshold)"
                         .into(),
                 ),
@@ -608,11 +636,11 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let after_w = win.mean(&r_after);
     let parts: Vec<(&[f64], String)> = match &fin {
         Some(f) => (nn + nc + 1..terms.len())
-            .map(|j| (f.parts[j].as_slice(), terms[j].kind.describe()))
+            .map(|j| (f.parts[j].as_slice(), terms[j].describe()))
             .collect(),
         None => vec![],
     };
-    let unexplained = assess(
+    let mut unexplained = assess(
         &d,
         &noise,
         &Sources {
@@ -623,6 +651,43 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
             after: &after_w,
         },
     );
+    // The floor: what the noise alone leaves in the gap, its slow levels
+    // at most those of a gyro of this grade; and above it by more than
+    // its uncertainty (the slow levels at their 95 % bounds, three of its
+    // standard deviations) the gap after is unexplained, whatever the
+    // noise model swallowed.
+    let caps = grade.value.noise_caps();
+    let keep = &d.wh.keep;
+    let (floor2, _) = expected_gap(&noise.capped(caps), &win, keep);
+    let hi2 = std::iter::once(&noise)
+        .chain(&bounds)
+        .map(|m| {
+            let (m2, v2) = expected_gap(&m.capped(caps), &win, keep);
+            m2 + 3.0 * v2.sqrt()
+        })
+        .fold(0.0, f64::max);
+    let noise_floor_dph = if short.is_none() {
+        floor2.sqrt() * 3600.0
+    } else {
+        floor
+    };
+    let floor_hi_dph = hi2.sqrt() * 3600.0;
+    if short.is_none() && unexplained.is_none() && gap_after > floor_hi_dph {
+        let fitted = (
+            noise.random_walk.sqrt() * 216_000.0,
+            noise.flicker.sqrt() * 3600.0,
+        );
+        let why = format!(
+            "the gap after the model, {gap_after:.4} deg/h, stands above what the noise of a {} gyro can leave ({noise_floor_dph:.4} deg/h, at most {floor_hi_dph:.4}); the noise fitted to it reads a random walk of {} deg/h/sqrt(h) and a bias instability of {} deg/h",
+            grade.value,
+            crate::report::text::sig(fitted.0),
+            crate::report::text::sig(fitted.1)
+        );
+        let excess = (gap_after.powi(2) - noise_floor_dph.powi(2))
+            .max(0.0)
+            .sqrt();
+        unexplained = Some(unexplained::beyond_floor(&d, &noise, &after_w, excess, why));
+    }
     let allan_after = allan_of(&inp.t, &r_after);
     Discovery {
         gyro: model.gyro,
@@ -637,7 +702,9 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
         skipped,
         gap_before_dph: gap_before,
         gap_after_dph: gap_after,
-        noise_floor_dph: floor,
+        noise_floor_dph,
+        noise_floor_hi_dph: floor_hi_dph,
+        noise_floor_white_dph: floor,
         noise,
         passes,
         fallback,

@@ -2,6 +2,7 @@
 //! window means), the noise floor there, and the stretches where it stands
 //! out.
 
+use super::noise_model::{markov_mean_var, NoiseModel};
 use super::windows::Windows;
 use crate::noise::analysis::{analyse, Allan};
 use crate::noise::gaps::fill_gaps;
@@ -16,27 +17,40 @@ pub struct Disagreement {
     pub peak_dph: f64,
 }
 
-/// Share of exactly equal neighbours beyond which a series is read as
-/// quantised at the level of its own noise.
-const QUANTISED_SHARE: f64 = 0.2;
+/// The ratio of the lower to the upper quartile of the squared neighbour
+/// differences of white Gaussian noise (chi-square(1)'s 0.1015/1.3233),
+/// and the band around it a series is read as such in.
+const QUARTILE_RATIO_BAND: (f64, f64) = (0.02, 0.4);
+/// ... and the most its 95 % quantile may exceed its median by (8.4 for
+/// a Gaussian; a few steps in a rate table's residual stay far below).
+const TAIL_RATIO_MAX: f64 = 100.0;
 
 /// The variance of one value of a series of white noise from its
 /// neighbours' squared differences `d2`: robustly, half their median over
 /// chi-square(1)'s (slow effects and a few steps are differenced away);
-/// but where a fifth or more of the neighbours are exactly equal (an RLG's
-/// angle counts, a MEMS gyro's word: the output quantised as coarsely as
-/// its noise) the median is no measure (it reads zero) and the mean of the
-/// squares is taken, its largest 1 % left out, over the share of a
-/// Gaussian's mean below its 99 % quantile (P(chi2_3 < 6.635)/0.99): the
-/// quantisation is part of the floor. None for fewer than two.
+/// but where the differences are not spread as a Gaussian's (their lower
+/// to upper quartile ratio, 0.077 for one, below 0.02 or above 0.4, or
+/// their 95 % quantile a hundred medians out: an RLG's angle counts or a
+/// MEMS gyro's word, the output quantised as coarsely as its noise, its
+/// differences clustered at zero and one count whatever smooth fit was
+/// taken off) the median is no measure (it reads nearly zero, or one
+/// count) and the mean of the squares is taken, its
+/// largest 1 % left out, over the share of a Gaussian's mean below its
+/// 99 % quantile (P(chi2_3 < 6.635)/0.99): the quantisation is part of the
+/// floor. None for fewer than two.
 pub fn white_var_of_diffs(d2: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = d2.iter().copied().filter(|x| x.is_finite()).collect();
     if v.len() < 2 {
         return None;
     }
     v.sort_by(f64::total_cmp);
-    let zeros = v.iter().filter(|x| **x == 0.0).count() as f64 / v.len() as f64;
-    if zeros < QUANTISED_SHARE {
+    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    let (q25, q50, q75, q95) = (q(0.25), q(0.5), q(0.75), q(0.95));
+    let gaussian = q75 > 0.0 && {
+        let r = q25 / q75;
+        (QUARTILE_RATIO_BAND.0..=QUARTILE_RATIO_BAND.1).contains(&r) && q95 < TAIL_RATIO_MAX * q50
+    };
+    if gaussian {
         return Some(v[v.len() / 2] / (2.0 * 0.454_936));
     }
     let kept = &v[..((v.len() as f64 * 0.99).ceil() as usize).max(1)];
@@ -144,4 +158,45 @@ pub fn disagreements(
         }
     }
     disagreements
+}
+
+/// The mean square the noise alone leaves in the gap's window means (once
+/// the constant every fit carries has taken its level), and that mean
+/// square's variance over this record, both in (deg/s)^2 and (deg/s)^4:
+/// the white noise of each kept window; each correlated process's
+/// variance of a window mean less that of the record's mean (physics.md
+/// 3's Markov terms, the flicker's sum of them); the random walk's wander
+/// about its mean, K^2 T/6. The variance: 2 v^2 tau/n for a process of
+/// window-mean variance v correlated over tau windows (1 for the white),
+/// K^4 T^2/45 for the walk (the Karhunen-Loeve eigenvalues of a demeaned
+/// Brownian motion, K^2 T^2/(pi j)^2), their standard deviations added (an
+/// upper bound).
+pub fn expected_gap(noise: &NoiseModel, win: &Windows, keep: &[bool]) -> (f64, f64) {
+    let kept: Vec<usize> = (0..win.len()).filter(|&k| keep[k]).collect();
+    let n = kept.len().max(1) as f64;
+    if win.len() < 2 {
+        return (noise.white, 2.0 * noise.white * noise.white / n);
+    }
+    let span = win.t[win.len() - 1] - win.t[0];
+    let mut counts = win.count.clone();
+    counts.sort_by(f64::total_cmp);
+    let nominal = counts[counts.len() / 2].max(1e-9);
+    let white = kept
+        .iter()
+        .map(|&k| noise.white * nominal / win.count[k].max(1e-9))
+        .sum::<f64>()
+        / n;
+    let spacing = (span / (win.len() - 1) as f64).max(1e-9);
+    let mut mean = white;
+    let mut sd = (2.0 * white * white / n).sqrt();
+    for (tc, v) in noise.processes(span) {
+        let vw = v * (markov_mean_var(spacing / tc) - markov_mean_var(span / tc)).max(0.0);
+        mean += vw;
+        let corr = (tc / spacing).clamp(1.0, n);
+        sd += (2.0 * vw * vw * corr / n).sqrt();
+    }
+    let k2 = noise.random_walk;
+    mean += k2 * span / 6.0;
+    sd += k2 * span / 45f64.sqrt();
+    (mean, sd * sd)
 }

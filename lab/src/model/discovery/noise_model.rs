@@ -161,6 +161,36 @@ impl NoiseModel {
         }
     }
 
+    /// The model with its slow levels no larger than a gyro's of the
+    /// given caps (bias instability deg/h, random walk deg/h/sqrt(h),
+    /// Markov deg/h; grade.rs's `noise_caps`).
+    pub fn capped(&self, (b, k, q): (f64, f64, f64)) -> Self {
+        let mut m = *self;
+        m.flicker = m.flicker.min((b / 3600.0).powi(2));
+        m.random_walk = m.random_walk.min((k / 216_000.0).powi(2));
+        m.markov = m.markov.min((q / 3600.0).powi(2));
+        m
+    }
+
+    /// Its stationary correlated processes over a record of `span` s:
+    /// (correlation time s, variance (deg/s)^2), the flicker's sum of
+    /// Markov processes first ([`Whitener`]'s).
+    pub fn processes(&self, span: f64) -> Vec<(f64, f64)> {
+        let mut comps = vec![];
+        if self.flicker > 0.0 {
+            let var_fl = self.flicker * FLICKER_SPACING.ln() / std::f64::consts::PI;
+            let mut tc = FLICKER_MIN_S;
+            while tc <= span.max(FLICKER_MIN_S) * FLICKER_SPACING {
+                comps.push((tc, var_fl));
+                tc *= FLICKER_SPACING;
+            }
+        }
+        if self.markov > 0.0 {
+            comps.push((self.markov_s.max(1e-6), self.markov));
+        }
+        comps
+    }
+
     /// Standard deviation of a mean over `tau` s of stationary noise
     /// (white and flicker; a random walk wanders, it has no level to
     /// deviate from), deg/s.
@@ -306,27 +336,18 @@ impl Whitener {
 
     /// [`Self::new`] for observations that are means over `block_s` s
     /// (blocks of windows, likelihood.rs): each correlated process's
-    /// variance is that of its mean over the block, and those faster than
-    /// [`WHITE_BEYOND`] correlation times per block join the white noise.
+    /// variance is that of its mean over the block and its correlation from
+    /// one block to the next that of those means (exact at lag one; as a
+    /// first-order process beyond), and those faster than [`WHITE_BEYOND`]
+    /// correlation times per block join the white noise.
     /// The random walk is taken at the blocks' times (its mean over a
     /// block differs by a third of a step, small beside the white noise of
     /// a block wherever the walk can be told from it).
     pub fn averaged(noise: &NoiseModel, win: &Windows, keep: &[bool], block_s: f64) -> Self {
         let n = win.len();
         let span = if n > 1 { win.t[n - 1] - win.t[0] } else { 1.0 };
-        let mut comps: Vec<(f64, f64)> = vec![];
-        if noise.flicker > 0.0 {
-            let var_fl = noise.flicker * FLICKER_SPACING.ln() / std::f64::consts::PI;
-            let mut tc = FLICKER_MIN_S;
-            while tc <= span.max(FLICKER_MIN_S) * FLICKER_SPACING {
-                comps.push((tc, var_fl));
-                tc *= FLICKER_SPACING;
-            }
-        }
         // The Markov process last, its own variance.
-        if noise.markov > 0.0 {
-            comps.push((noise.markov_s.max(1e-6), noise.markov));
-        }
+        let comps = noise.processes(span);
         let mut taus: Vec<f64> = vec![];
         let mut vars: Vec<f64> = vec![];
         let mut white_extra = 0.0;
@@ -355,12 +376,27 @@ impl Whitener {
         let mut inv_sd = vec![0.0; n];
         let mut log_det = 0.0;
         let mut ph = vec![1.0; s];
+        let mut last_dt = f64::NAN;
         for k in 0..n {
             if k > 0 {
                 let dt = (win.t[k] - win.t[k - 1]).max(0.0);
-                ph[0] = 1.0;
-                for (i, tc) in taus.iter().enumerate() {
-                    ph[i + 1] = (-dt / tc).exp();
+                // The factors change only with the spacing.
+                if dt != last_dt {
+                    last_dt = dt;
+                    ph[0] = 1.0;
+                    for (i, tc) in taus.iter().enumerate() {
+                        ph[i + 1] = if block_s > 0.0 {
+                            // Block means: the lag-one correlation of an
+                            // Ornstein-Uhlenbeck process's means over
+                            // x = block/tc, (1 - e^-x)^2/(x^2 g(x)), then
+                            // the decay over any gap beyond a block.
+                            let x = block_s / tc;
+                            let lag1 = (1.0 - (-x).exp()).powi(2) / (x * x * markov_mean_var(x));
+                            lag1.min(1.0) * (-(dt - block_s).max(0.0) / tc).exp()
+                        } else {
+                            (-dt / tc).exp()
+                        };
+                    }
                 }
                 for i in 0..s {
                     for j in 0..s {

@@ -21,7 +21,7 @@
 //! cheapest first (backward steps), never to return.
 
 use super::design::{Design, Fit};
-use super::terms::{without, Kind, Shape, Term};
+use super::terms::{without, Kind, Shape, Term, PERIODIC_MIN_S};
 use super::transients::{cusum_peaks, step_peaks, white_sigma, MAX_STEPS};
 use crate::model::effects::Effect;
 use crate::model::ranges;
@@ -182,6 +182,7 @@ pub fn params_of(terms: &[Term], fit: &Fit, j: usize) -> Vec<(&'static str, f64)
 pub fn columns(k: Kind) -> usize {
     match k {
         Kind::Effect(e) => e.linear_params().len(),
+        Kind::Periodic => 2,
         _ => 1,
     }
 }
@@ -208,30 +209,48 @@ impl Trial {
 /// Every candidate in `open`, fitted with `base` (criterion `c_cur`, its
 /// whitened residual `r_cur`).
 fn trials(d: &Design, open: &[Term], base: &[Term], r_cur: &[f64], c_cur: f64) -> Vec<Trial> {
-    let mut out = vec![];
-    for cand in open {
+    let trial = |cand: Term, full: bool| -> Option<Trial> {
         let mut terms = base.to_vec();
-        terms.push(*cand);
+        terms.push(cand);
         let dof: usize = terms.iter().map(|t| t.kind.dof()).sum();
         // A fit must leave the residual some scatter to measure its noise
         // by: as many parameters as windows fit any record exactly.
         if (dof as f64) + MIN_RESIDUAL_DOF > d.n() {
-            continue;
+            return None;
         }
         let j = terms.len() - 1;
-        d.optimize(&mut terms, j);
-        let Some(f) = d.fit(&terms) else {
-            continue;
-        };
-        out.push(Trial {
+        if full {
+            d.optimize(&mut terms, j);
+        } else {
+            d.optimize_on_grid(&mut terms, j);
+        }
+        let f = d.fit(&terms)?;
+        Some(Trial {
             term: terms[j],
             delta: d.criterion(f.sse, dof) - c_cur,
             explained: r_cur.iter().zip(&f.resid).map(|(a, b)| a - b).collect(),
             params: params_of(&terms, &f, j),
-        });
+        })
+    };
+    // Every candidate on its parameter's grid; then those that could
+    // lead, their parameter refined between the grid's points.
+    let mut out: Vec<Trial> = open.iter().filter_map(|c| trial(*c, false)).collect();
+    let best = out.iter().map(|t| t.delta).fold(f64::INFINITY, f64::min);
+    for t in out.iter_mut() {
+        if d.searched(&t.term) && t.delta <= best + REFINE_MARGIN {
+            if let Some(r) = trial(Term::of(t.term.kind), true) {
+                if r.delta <= t.delta {
+                    *t = r;
+                }
+            }
+        }
     }
     out
 }
+
+/// Candidates whose grid search comes within this much of the best
+/// trial's criterion have their parameter refined.
+const REFINE_MARGIN: f64 = 2.0 * AMBIGUITY_MARGIN;
 
 /// The library trials the run cannot tell from `best` (plausible, within
 /// the margin, correlated): (effect, correlation, criterion change), best
@@ -270,6 +289,8 @@ struct State {
     /// Effects and shapes that may no longer come in, and step times.
     closed: Vec<Kind>,
     closed_steps: Vec<f64>,
+    /// Kinds the selection never offers (set aside by the confirmation).
+    excluded: Vec<Kind>,
 }
 
 impl State {
@@ -386,7 +407,12 @@ fn recheck(d: &Design, st: &mut State) {
 /// the steps offered.
 fn open(d: &Design, candidates: &[Effect], st: &State) -> Vec<Term> {
     let inside = st.sel.terms();
-    let taken = |k: Kind| st.closed.contains(&k) || inside.iter().any(|t| t.kind == k);
+    let taken = |k: Kind| {
+        st.closed.contains(&k) || st.excluded.contains(&k) || inside.iter().any(|t| t.kind == k)
+    };
+    let periodic = (d.win.len() > 1
+        && d.win.t[d.win.len() - 1] - d.win.t[0] >= 3.0 * PERIODIC_MIN_S)
+        .then_some(Kind::Periodic);
     let mut v: Vec<Term> = candidates
         .iter()
         .map(|&e| Kind::Effect(e))
@@ -396,13 +422,14 @@ fn open(d: &Design, candidates: &[Effect], st: &State) -> Vec<Term> {
                 .filter(|s| s.available(d.inp))
                 .map(Kind::Shape),
         )
+        .chain(periodic)
         .filter(|&k| !taken(k))
         .map(Term::of)
         .collect();
     // Steps: those found after the first pass, and where the current
     // residual's level jumps most (a step is searched for like a knee).
     let n_steps = inside.iter().filter(|t| t.kind == Kind::Step).count();
-    if n_steps < MAX_STEPS && st.closed_steps.is_empty() {
+    if n_steps < MAX_STEPS && st.closed_steps.is_empty() && !st.excluded.contains(&Kind::Step) {
         let mut xs = d.steps.clone();
         if let Some(f) = d.fit(&inside) {
             let parts = d.parts(&inside, &f.coef);
@@ -502,8 +529,9 @@ fn exchange(d: &Design, candidates: &[Effect], st: &State) -> Option<(usize, Ter
 }
 
 /// Stepwise selection over `candidates` (library effects; not the bias,
-/// whose constant every fit carries).
-pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
+/// whose constant every fit carries), never offering the kinds in
+/// `excluded` (shapes, steps, the periodic disturbance).
+pub fn select(d: &Design, candidates: &[Effect], excluded: &[Kind]) -> Selection {
     let mut st = State {
         sel: Selection {
             named: vec![],
@@ -515,10 +543,11 @@ pub fn select(d: &Design, candidates: &[Effect]) -> Selection {
         },
         closed: vec![],
         closed_steps: vec![],
+        excluded: excluded.to_vec(),
     };
     let mut exchanges = 0;
     let mut next_forced: Option<Term> = None;
-    for _ in 0..4 * (candidates.len() + Shape::ALL.len() + d.steps.len() + 2) {
+    for _ in 0..4 * (candidates.len() + Shape::ALL.len() + d.steps.len() + 3) {
         let forced = next_forced.take();
         let base = st.sel.terms();
         let Some(cur) = d.fit(&base) else {

@@ -1,10 +1,13 @@
 //! What a discovery fit is made of: the constant every fit carries, the
 //! library's effects (effects.rs), and shapes the library has no name
 //! for. A shape is a rival, never a name: when the residual is better
-//! explained by the rate squared, the rate cubed, a ramp in time, the
-//! temperature squared, a temperature's curvature or a step than by any
-//! effect, it is taken as what no effect of the library explains, so that
-//! no effect is bent to imitate it (docs/discovery.md).
+//! explained by the rate squared, the rate cubed, w|w|, a scale factor
+//! following the temperature's square or its rate, a ramp in time, the
+//! temperature squared, a temperature's curvature, the case less the
+//! monoblocks, |acceleration|, a step or a periodic disturbance than by
+//! any effect, it is taken as what no effect of the library explains, so
+//! that no effect is bent to imitate it (docs/discovery.md). The shapes
+//! are the physical forms issue 32 names outside the library.
 
 use crate::data::run_file::Column;
 use crate::model::effects::Effect;
@@ -24,6 +27,9 @@ pub const CURVATURE_HALF_WIDTH_S: f64 = 120.0;
 pub enum Shape {
     RateSquared,
     RateCubed,
+    RateAbsRate,
+    RateTempSquared,
+    RateTempRate,
     Ramp,
     TimeSquared,
     TempSquared,
@@ -31,12 +37,17 @@ pub enum Shape {
     CaseSquared,
     CaseRate,
     CaseCurvature,
+    CaseMinusMono,
+    AbsAcc,
 }
 
 impl Shape {
-    pub const ALL: [Shape; 9] = [
+    pub const ALL: [Shape; 14] = [
         Shape::RateSquared,
         Shape::RateCubed,
+        Shape::RateAbsRate,
+        Shape::RateTempSquared,
+        Shape::RateTempRate,
         Shape::Ramp,
         Shape::TimeSquared,
         Shape::TempSquared,
@@ -44,6 +55,8 @@ impl Shape {
         Shape::CaseSquared,
         Shape::CaseRate,
         Shape::CaseCurvature,
+        Shape::CaseMinusMono,
+        Shape::AbsAcc,
     ];
 
     /// What the shape follows, in the run's terms.
@@ -54,6 +67,13 @@ impl Shape {
         match self {
             Shape::RateSquared => format!("{w}^2 (a rate-squared term)"),
             Shape::RateCubed => format!("{w}^3 (a rate-cubed term)"),
+            Shape::RateAbsRate => format!("{w} |{w}| (a rate-squared term odd in the rate)"),
+            Shape::RateTempSquared => {
+                format!("{w} ({t} - 20)^2 (a scale factor quadratic in temperature)")
+            }
+            Shape::RateTempRate => {
+                format!("{w} d({t})/dt (a scale factor following the temperature's rate)")
+            }
             Shape::Ramp => format!("{} (a drift linear in time)", Column::Time.name()),
             Shape::TimeSquared => format!("{}^2 (a drift curving in time)", Column::Time.name()),
             Shape::TempSquared => format!("({t} - 20)^2"),
@@ -61,16 +81,27 @@ impl Shape {
             Shape::CaseSquared => format!("({c} - 20)^2"),
             Shape::CaseRate => format!("d({c})/dt"),
             Shape::CaseCurvature => format!("d2({c})/dt2"),
+            Shape::CaseMinusMono => format!(
+                "{c} - ({} + {})/2 (the case less the monoblocks)",
+                Column::MonoA.name(),
+                Column::MonoB.name()
+            ),
+            Shape::AbsAcc => format!("|{}|", Column::RefAcc.name()),
         }
     }
 
     /// Whether the run can show it.
     pub fn available(self, inp: &Inputs) -> bool {
         match self {
-            Shape::RateSquared | Shape::RateCubed => rotating(inp),
+            Shape::RateSquared | Shape::RateCubed | Shape::RateAbsRate => rotating(inp),
+            Shape::RateTempSquared | Shape::RateTempRate => rotating(inp) && inp.temp.is_some(),
             Shape::Ramp | Shape::TimeSquared => true,
             Shape::TempSquared | Shape::TempCurvature => inp.temp.is_some(),
             Shape::CaseSquared | Shape::CaseRate | Shape::CaseCurvature => inp.case.is_some(),
+            Shape::CaseMinusMono => inp.case.is_some() && inp.mono_mean.is_some(),
+            // A measured acceleration only: one derived from a rate
+            // table's steps is spikes at its transitions.
+            Shape::AbsAcc => !inp.acc_derived,
         }
     }
 
@@ -89,6 +120,21 @@ impl Shape {
         match self {
             Shape::RateSquared => w.iter().map(|x| x * x).collect(),
             Shape::RateCubed => w.iter().map(|x| x * x * x).collect(),
+            Shape::RateAbsRate => w.iter().map(|x| x * x.abs()).collect(),
+            Shape::RateTempSquared => w
+                .iter()
+                .zip(temp)
+                .map(|(x, c)| x * (c - 20.0).powi(2))
+                .collect(),
+            Shape::RateTempRate => {
+                let r = inp.temp_rate.as_ref().unwrap_or(&zeros);
+                w.iter().zip(r).map(|(x, d)| x * d).collect()
+            }
+            Shape::CaseMinusMono => {
+                let m = inp.mono_mean.as_ref().unwrap_or(&zeros);
+                case.iter().zip(m).map(|(c, m)| c - m).collect()
+            }
+            Shape::AbsAcc => inp.acc.iter().map(|a| a.abs()).collect(),
             // From the record's start: the constant is then the bias there.
             Shape::Ramp => inp.t.iter().map(|t| (t - t0) / span).collect(),
             Shape::TimeSquared => inp.t.iter().map(|t| ((t - t0) / span).powi(2)).collect(),
@@ -167,6 +213,8 @@ pub enum Kind {
     Shape(Shape),
     /// A step of the output at time x.
     Step,
+    /// A periodic disturbance of period x: a sinusoid of any phase.
+    Periodic,
     /// The warm-up's decaying form, exp(-t/x): with the constant, the same
     /// as the warm-up's A (1 - exp(-t/x)); alone, a warm-up that settles
     /// to no bias.
@@ -187,6 +235,7 @@ impl Kind {
         match self {
             Kind::Effect(e) => e.dof(),
             Kind::Step | Kind::Decay => 2,
+            Kind::Periodic => 3,
             _ => 1,
         }
     }
@@ -198,6 +247,7 @@ impl Kind {
             Kind::Effect(e) => e.name().into(),
             Kind::Shape(s) => s.describe(),
             Kind::Step => "a step".into(),
+            Kind::Periodic => "a periodic disturbance".into(),
             Kind::Decay => "a decaying warm-up".into(),
         }
     }
@@ -214,6 +264,36 @@ impl Term {
     pub fn of(kind: Kind) -> Self {
         Self { kind, x: 0.0 }
     }
+}
+
+impl Term {
+    /// Its name in the report, with its time or period.
+    pub fn describe(&self) -> String {
+        match self.kind {
+            Kind::Step => format!("a step at {:.0} s", self.x),
+            Kind::Periodic => format!("a periodic disturbance of period {:.0} s", self.x),
+            k => k.describe(),
+        }
+    }
+}
+
+/// Shortest period of a periodic disturbance offered, s (faster ones are
+/// a vibration's or noise's).
+pub const PERIODIC_MIN_S: f64 = 600.0;
+
+/// The periods a periodic disturbance is searched over on a record of
+/// `span` s: log-spaced from [`PERIODIC_MIN_S`] to 1.5 times the record
+/// (a longer period is a curvature, for the ramp and the time squared),
+/// none on a record shorter than three of the shortest.
+pub fn periodic_grid(span: f64) -> Vec<f64> {
+    if span < 3.0 * PERIODIC_MIN_S {
+        return vec![];
+    }
+    let (a, b) = (PERIODIC_MIN_S.ln(), (1.5 * span).ln());
+    let n = 36;
+    (0..n)
+        .map(|i| (a + (b - a) * i as f64 / (n - 1) as f64).exp())
+        .collect()
 }
 
 /// `terms` without its `j`-th: the model a term's worth is judged against.

@@ -274,3 +274,58 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         spikes: src.spikes.len(),
     })
 }
+
+/// What is unexplained when the gap after the model stands above what
+/// the noise can leave (noise_floor.rs's `expected_gap`, with the slow
+/// levels at most a gyro of its grade has) by more than that level's own
+/// uncertainty, though no term of the fit carries it: the residual after
+/// the model (`after`, window means, deg/s) is the unexplained part, the
+/// spans are the minutes whose means stand three of `noise`'s sigmas out,
+/// and `why` says what gave it away.
+pub fn beyond_floor(
+    d: &Design,
+    noise: &NoiseModel,
+    after: &[f64],
+    excess_dph: f64,
+    why: String,
+) -> Unexplained {
+    let t = &d.win.t;
+    let half =
+        0.5 * (t.get(1).copied().unwrap_or(1.0) - t.first().copied().unwrap_or(0.0)).max(0.0);
+    let sd60 = noise.sd_of_mean(BLOCK_WINDOWS as f64, 1.0);
+    let mut spans: Vec<Span> = vec![];
+    for (a, b, m) in blocks(after) {
+        if m.abs() <= 3.0 * sd60 {
+            continue;
+        }
+        match spans.last_mut() {
+            Some(s) if t[a] - half <= s.to_s + 2.0 * BLOCK_WINDOWS as f64 => {
+                s.to_s = t[b] + half;
+                if m.abs() * 3600.0 > s.peak_dph.abs() {
+                    s.peak_dph = m * 3600.0;
+                }
+            }
+            _ => spans.push(Span {
+                from_s: t[a] - half,
+                to_s: t[b] + half,
+                peak_dph: m * 3600.0,
+            }),
+        }
+    }
+    let mut correlates: Vec<Correlate> = inputs(d)
+        .into_iter()
+        .map(|(name, x)| Correlate {
+            correlation: pearson(after, &x),
+            input: name,
+        })
+        .filter(|c| c.correlation.is_finite())
+        .collect();
+    correlates.sort_by(|a, b| b.correlation.abs().total_cmp(&a.correlation.abs()));
+    Unexplained {
+        excess_dph,
+        spans,
+        correlates,
+        carried_by: vec![why],
+        spikes: 0,
+    }
+}
