@@ -2,12 +2,14 @@
 
 use crate::cli::adev_plot::adev_series;
 use crate::model::discovery::estimates::Estimate;
+use crate::model::discovery::noise_model::markov_avar;
 use crate::model::discovery::{Discovery, Run, WINDOW_S};
 use crate::model::effects::Effect;
 use crate::noise::terms;
 use crate::report::document::Report;
 use crate::report::plot::{Axes, Series};
 use crate::report::text::{num, sig};
+use crate::report::verdict::Verdict;
 use std::path::Path;
 
 const DPH: f64 = 3600.0;
@@ -67,15 +69,25 @@ fn allan_section(r: &mut Report, d: &Discovery) {
         r.heading("Allan deviation before and after, against the noise floor");
         let mut s = adev_series(a, "before", 0, false);
         s.extend(adev_series(b, "after", 1, false));
-        let floor: Vec<(f64, f64)> = a
+        // The noise model the discovery judged against (its slow levels
+        // at most the grade's), as an Allan deviation: white N^2/tau with
+        // N^2 the variance of a 1 s mean, flicker's floor, the Markov
+        // term, the random walk's K^2 tau/3. (The Allan terms of the
+        // residual before the model read a missing effect as noise.)
+        let m = d.noise.capped(d.grade.value.noise_caps());
+        let model: Vec<(f64, f64)> = a
             .taus
             .iter()
+            .filter(|&&t| t >= WINDOW_S)
             .map(|&t| {
-                let v: f64 = (0..3).map(|j| a.terms.c[j] * terms::basis(j, t)).sum();
+                let v = m.white * WINDOW_S / t
+                    + m.flicker * terms::basis(2, t)
+                    + m.markov * markov_avar(t, m.markov_s.max(1e-9))
+                    + m.random_walk * t / 3.0;
                 (t, v.sqrt() * DPH)
             })
             .collect();
-        s.push(Series::dashed("noise floor", floor, 7));
+        s.push(Series::dashed("noise model (the floor's)", model, 7));
         r.plot(
             &Axes {
                 title: "Allan deviation of the residual".into(),
@@ -85,8 +97,9 @@ fn allan_section(r: &mut Report, d: &Discovery) {
                 log_y: true,
             },
             &s,
-            "A missing effect lifts the residual's Allan deviation above the noise floor (quantization, angle \
-             random walk, bias instability) at long averaging; once it is in the model the curve comes down.",
+            "A missing effect lifts the residual's Allan deviation above the noise model at long averaging; once \
+             it is in the model the \"after\" curve lies on the noise model's (dashed: the residual's white, \
+             flicker, Markov and random-walk levels as fitted, each at most the grade's; at 1 s it is the floor).",
         );
     }
 }
@@ -297,11 +310,111 @@ fn ambiguous_and_skipped(r: &mut Report, d: &Discovery) {
     }
 }
 
+/// The verdict: what was found, how much of the gap it closed, what is
+/// left and where, each number tagged with its JSON key.
+fn verdict(d: &Discovery) -> Verdict {
+    let mut v = Verdict::new();
+    if d.found.is_empty() {
+        v.text("Nothing is named. ");
+    } else {
+        v.text("Found ");
+        for (i, e) in d.found.iter().enumerate() {
+            if i > 0 {
+                v.text(if i + 1 == d.found.len() {
+                    " and "
+                } else {
+                    ", "
+                });
+            }
+            v.word(&format!("found.{i}.effect"), e.effect.name());
+            let lin = e.effect.linear_params();
+            if let Some(p) = e
+                .params
+                .iter()
+                .find(|p| lin.contains(&p.0))
+                .or(e.params.first())
+            {
+                v.text(" (").text(p.0).text(" ").text(&sig(p.1)).text(")");
+            }
+        }
+        v.text(". ");
+    }
+    v.text("The gap (RMS of 1 s means of measured - model) went from ")
+        .num("gap_before_dph", d.gap_before_dph, 4)
+        .text(" to ")
+        .num("gap_after_dph", d.gap_after_dph, 4)
+        .text(" deg/h against a noise floor of ")
+        .num("noise_floor_dph", d.noise_floor_dph, 4)
+        .text(" deg/h");
+    let excess = |g: f64| (g * g - d.noise_floor_dph.powi(2)).max(0.0);
+    if excess(d.gap_before_dph) > 0.0 {
+        let closed = 100.0 * (1.0 - excess(d.gap_after_dph) / excess(d.gap_before_dph));
+        v.text(&format!(
+            " ({closed:.0} % of what stood above the floor closed)"
+        ));
+    }
+    v.text("; ")
+        .word("grade.value", d.grade.value.name())
+        .text(if d.grade.inferred {
+            " grade, judged from the run's white noise. "
+        } else {
+            " grade, given. "
+        });
+    match &d.unexplained {
+        Some(u) => {
+            v.text("Left unexplained: ")
+                .num("unexplained.excess_dph", u.excess_dph, 4)
+                .text(" deg/h above the noise, carried by ")
+                .text(&u.carried_by.join("; "));
+            if let (Some(a), Some(b)) = (u.spans.first(), u.spans.last()) {
+                v.text(&format!(
+                    ", in {} span(s) from {} s to {} s",
+                    u.spans.len(),
+                    sig(a.from_s),
+                    sig(b.to_s)
+                ));
+            }
+            if let Some(c) = u.correlates.first() {
+                v.text(&format!(
+                    ", following {} most (r = {:+.2})",
+                    c.input, c.correlation
+                ));
+            }
+            v.warning(
+                "unexplained",
+                "no effect of the library explains what is left; it is not in the model written",
+            );
+        }
+        None => {
+            v.text("Nothing is left above the noise.");
+        }
+    }
+    if !d.ambiguous.is_empty() {
+        v.warning(
+            "ambiguous",
+            &format!(
+                "this run cannot tell apart {}",
+                d.ambiguous
+                    .iter()
+                    .map(|g| Effect::names(&g.effects, " / "))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        );
+    }
+    if let Some(s) = &d.short {
+        v.warning("short_record", s);
+    }
+    v
+}
+
 pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
     let mut r = Report::new(&format!("What the model misses: {}", data.display()));
+    r.verdict(&verdict(d));
     r.paragraph(&format!(
         "{} gyro, {} rows ({} s windows: {}). Gap (RMS of {WINDOW_S} s means of measured - model): {} deg/h \
-         before, {} deg/h after; noise floor there {} deg/h (the Allan noise terms of the residual).",
+         before, {} deg/h after; noise floor there {} deg/h (what the residual's noise, its slow levels at \
+         most the grade's, leaves in the gap).",
         d.gyro.name(),
         run.inputs.len(),
         WINDOW_S,

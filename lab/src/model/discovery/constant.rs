@@ -94,6 +94,13 @@ pub fn role(d: &Design, sel: &Selection, candidates: &[Effect]) -> (Role, Option
         if !ranges::outside(e, &p, &d.extent).is_empty() {
             continue;
         }
+        // A warm-up that settles within a twentieth of the record is the
+        // constant after its first minutes: the simpler, one-parameter
+        // bias is what the record shows, not an ambiguity a longer record
+        // would resolve.
+        if e == Effect::WarmUp && ts[j].x < d.extent.record_s / 20.0 {
+            continue;
+        }
         let ex: Vec<f64> = f0.resid.iter().zip(&f.resid).map(|(a, b)| a - b).collect();
         let c = corr(&explained, &ex);
         if c.abs() >= AMBIGUITY_CORR {

@@ -31,6 +31,7 @@ pub mod select;
 pub mod terms;
 pub mod transients;
 pub mod unexplained;
+pub mod white;
 pub mod windows;
 
 use crate::data::run_file::Column;
@@ -270,7 +271,6 @@ fn passes<'a>(
         vec![],
     );
     let sel1 = select(&d1, cands, excluded);
-    debug_pass("1", &sel1, &NoiseModel::white_of(rw, &all));
     let e1 = left(&d1, &sel1.terms());
     let tr = transients::find(win, &e1);
     let keep = tr.keep(n);
@@ -292,7 +292,6 @@ fn passes<'a>(
     };
     let d2 = design(&noise_a);
     let sel2 = select(&d2, cands, excluded);
-    debug_pass("2", &sel2, &noise_a);
     // The noise's slow levels by maximum likelihood given what the second
     // pass selected, then the selection again on that noise (weighing the
     // criterion by the correlation its whitened residual still holds);
@@ -310,7 +309,6 @@ fn passes<'a>(
         let mut d = design(&noise);
         d.phi = d.fit(&prev).map_or(1.0, |f| inflation(&f.resid, &keep));
         let sel = select(&d, cands, excluded);
-        debug_pass(&pass.to_string(), &sel, &noise);
         let now = sel.named_effects();
         if now == names || pass >= MAX_PASSES {
             return (d, sel, noise, tr, pass);
@@ -319,27 +317,6 @@ fn passes<'a>(
         prev = sel.terms();
         noise = ml(&d, &sel, &noise);
     }
-}
-
-/// With GYRO_LAB_DEBUG set: a pass's terms and noise, on stderr.
-fn debug_pass(pass: &str, sel: &Selection, noise: &NoiseModel) {
-    if std::env::var_os("GYRO_LAB_DEBUG").is_none() {
-        return;
-    }
-    let terms: Vec<String> = sel
-        .terms()
-        .iter()
-        .map(|t| format!("{}@{:.4}", t.kind.describe(), t.x))
-        .collect();
-    eprintln!(
-        "pass {pass}: [{}] white {:.4} dph, flicker {:.4} dph, rw {:.4} dph/sqrt(h), markov {:.4} dph over {:.0} s",
-        terms.join(", "),
-        noise.white.sqrt() * 3600.0,
-        noise.flicker.sqrt() * 3600.0,
-        noise.random_walk.sqrt() * 3600.0 * 60.0,
-        noise.markov.sqrt() * 3600.0,
-        noise.markov_s
-    );
 }
 
 /// What a short record's intervals rest on, said plainly (None for a
@@ -525,9 +502,12 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     if role == Role::Named && short.is_none() {
         let g = confirm::constant_gain(&d, &sel, &noise);
         if g < select::THRESHOLD {
+            // Not named a bias (the noise's slow wander imitates it), but
+            // carried: the level the noise wanders about, which the gap
+            // and its floor are taken from (a MEMS gyro's turn-on bias of
+            // hundreds of deg/h is one a flicker of tens can imitate).
             not_confirmed.push((Kind::Constant, g));
-            let alone = sel.named.is_empty() && sel.carried.is_empty() && sel.nuisance.is_empty();
-            role = if alone { Role::Unneeded } else { Role::Carried };
+            role = Role::Carried;
         }
     }
     let terms = sel.terms();
@@ -565,7 +545,7 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
                 Role::Named => None,
                 Role::Ambiguous => Some("the constant, for the ambiguous group it heads".into()),
                 _ if not_confirmed.iter().any(|x| x.0 == Kind::Constant) => Some(
-                    "the constant the other terms are fitted with (not named a bias: once the noise is re-fitted without it, it gains less than the threshold)"
+                    "the level the noise wanders about (not named a bias: once the noise is re-fitted without it, it gains less than the threshold)"
                         .into(),
                 ),
                 _ => Some(
@@ -622,6 +602,16 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let mut found = vec![];
     let mut carried = vec![];
     for (_, e, why) in written {
+        // Named only where the interval, as written (after any re-fit),
+        // excludes zero.
+        let why = match why {
+            None if holds_zero(&e) => Some(if e.effect == Effect::Bias {
+                format!("the constant the other terms are fitted with (not named a bias: {NOT_SIGNIFICANT})")
+            } else {
+                format!("not named: {NOT_SIGNIFICANT}")
+            }),
+            w => w,
+        };
         match why {
             None => found.push(e),
             Some(w) => carried.push(Carried {

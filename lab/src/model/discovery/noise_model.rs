@@ -72,7 +72,7 @@ impl NoiseModel {
             .map(|(v, _)| *v)
             .collect();
         let d2: Vec<f64> = m.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
-        let white = super::noise_floor::white_var_of_diffs(&d2)
+        let white = super::white::white_var_of_diffs(&d2)
             .unwrap_or(1e-12)
             .max(1e-30);
         Self {

@@ -50,9 +50,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// differences (noise_floor.rs's `white_var_of_diffs`).
 pub fn white_sigma(e: &[f64]) -> f64 {
     let d2: Vec<f64> = e.windows(2).map(|p| (p[1] - p[0]).powi(2)).collect();
-    super::noise_floor::white_var_of_diffs(&d2)
-        .unwrap_or(0.0)
-        .sqrt()
+    super::white::white_var_of_diffs(&d2).unwrap_or(0.0).sqrt()
 }
 
 /// The times of the `most` largest jumps of `e`'s level (the mean over
