@@ -1,6 +1,7 @@
 //! `cargo xtask qemu | test | bench`: developer entry points. Each first installs
 //! what it needs (thumbv7em target, qemu-system-arm, flip-link, defmt-print).
 
+mod capture;
 mod frames;
 mod record_test;
 mod setup;
@@ -76,6 +77,9 @@ pub fn build_firmware(board: &str) -> Result<PathBuf> {
         .join(format!("gyro-fw-{board}")))
 }
 
+/// QEMU's clock: instruction-counted, never the host's (see [`qemu_command`]).
+pub const QEMU_ICOUNT: &str = "shift=0,sleep=off";
+
 /// Output of one QEMU run.
 pub struct QemuRun {
     pub log: String,
@@ -90,8 +94,16 @@ pub const QEMU_STALL: std::time::Duration = std::time::Duration::from_secs(60);
 /// And no run takes longer than this at all.
 pub const QEMU_LIMIT: std::time::Duration = std::time::Duration::from_secs(20 * 60);
 
-/// qemu-system-arm on the `qemu` firmware, deterministic (-icount
-/// shift=0); `serial`: QEMU's -serial argument (a file, or `pty`).
+/// qemu-system-arm on the `qemu` firmware, deterministic; `serial`: QEMU's
+/// -serial argument (a file, or `pty`). Every QEMU run is made here.
+///
+/// `-icount shift=0`: one instruction is 1 ns of virtual time, so SysTick and
+/// TIM2 count instructions. `sleep=off`: while the guest sleeps in WFI the
+/// virtual clock jumps to the next timer deadline. With icount's default
+/// (`sleep=on`) it runs on the host's real time there, so how late the next
+/// interrupt lands, and every frame after it, would depend on the host's
+/// speed and load. A guest blocked on a full serial backend (a slow reader
+/// on the pty) executes nothing, so its clock stands still there too.
 pub fn qemu_command(elf: &Path, serial: &str) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args([
@@ -107,7 +119,7 @@ pub fn qemu_command(elf: &Path, serial: &str) -> Command {
         "-semihosting-config",
         "enable=on,target=native",
         "-icount",
-        "shift=0",
+        QEMU_ICOUNT,
     ])
     .arg("-serial")
     .arg(serial)
@@ -155,7 +167,7 @@ pub fn wait_progressing(
     }
 }
 
-/// Runs the `qemu` firmware deterministically (-icount shift=0) and decodes defmt.
+/// Runs the `qemu` firmware deterministically ([`QEMU_ICOUNT`]) and decodes defmt.
 pub fn run_qemu() -> Result<QemuRun> {
     let elf = build_firmware("qemu")?;
     let dir = root().join("runs");
@@ -265,7 +277,12 @@ fn record_test_cmd() -> Result<()> {
 fn record_tests(qrun: &QemuRun) -> Result<()> {
     let clean = record_qemu_run(qrun)?;
     run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
-    let checks = record_test::run(&qrun.elf, &clean, &root().join("runs/qemu-reference.csv"))?;
+    let checks = record_test::run(
+        &qrun.elf,
+        &clean,
+        &qrun.frames_path,
+        &root().join("runs/qemu-reference.csv"),
+    )?;
     let failed = checks.iter().filter(|c| !c.1).count();
     for (name, ok, detail) in &checks {
         println!(
