@@ -3,6 +3,7 @@
 
 mod capture;
 mod frames;
+mod panic_paths;
 mod record_test;
 mod setup;
 
@@ -20,8 +21,10 @@ fn main() {
         Some("bench") => bench_cmd(),
         // The board-to-lab tests alone (part of `test`).
         Some("record-test") => record_test_cmd(),
+        // The interrupt handlers' freedom from panics (part of `test`).
+        Some("isr-proof") => isr_proof_cmd(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu|test|bench>");
+            eprintln!("usage: cargo xtask <qemu|test|bench|record-test|isr-proof>");
             std::process::exit(2);
         }
     };
@@ -245,7 +248,7 @@ fn test_cmd() -> Result<()> {
         .args(FIRMWARE)
         .args(["--lib", "--", "-D", "warnings"]))?;
     run(cargo().args(["test", "--workspace", "--profile", "host-test"]))?;
-    build_firmware("hw")?;
+    isr_proof(&build_firmware("hw")?)?;
     // Tests of the firmware under QEMU.
     let qrun = run_qemu()?;
     let report = frames::analyse(&qrun.frames_path)?;
@@ -263,6 +266,53 @@ fn test_cmd() -> Result<()> {
         bail!("{failed} firmware test(s) under QEMU failed");
     }
     record_tests(&qrun)
+}
+
+/// The interrupts that must exist in the hw image: the FOG closure (ADC
+/// DMA) and the RLG update (TIM5).
+const HW_HANDLERS: [&str; 2] = ["DMA2_STREAM0", "TIM5"];
+
+/// No interrupt handler of the hw release image reaches a panic
+/// (`panic_paths.rs`): each handler in its vector table is checked.
+fn isr_proof(elf: &Path) -> Result<()> {
+    let proof = panic_paths::check(elf)?;
+    let verdicts = &proof.handlers;
+    for h in HW_HANDLERS {
+        if !verdicts.iter().any(|(name, _)| name == h) {
+            bail!("the hw image's vector table has no {h} handler");
+        }
+    }
+    if let Some(p) = &proof.entry {
+        println!("isr proof: start-up may panic (a reset, docs/panics.md), e.g. {p}");
+    }
+    match &proof.idle {
+        Some(None) => println!("isr proof: the idle loop has no path to a panic"),
+        Some(Some(p)) => println!("isr proof: the idle loop may panic (a reset), e.g. {p}"),
+        None => {}
+    }
+    let mut failed = 0;
+    for (name, path) in verdicts {
+        match path {
+            None => println!("isr proof {name} ... ok (no path to a panic)"),
+            Some(p) => {
+                failed += 1;
+                println!("isr proof {name} ... FAILED: {p}");
+            }
+        }
+    }
+    if failed > 0 {
+        bail!(
+            "{failed} interrupt handler(s) of {} can panic",
+            elf.display()
+        );
+    }
+    Ok(())
+}
+
+/// `cargo xtask isr-proof`: the proof alone, on a fresh hw build.
+fn isr_proof_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    isr_proof(&build_firmware("hw")?)
 }
 
 /// `cargo xtask record-test`: the QEMU run and the board-to-lab tests.
