@@ -5,7 +5,7 @@
 use crate::calibration::scale_factor::diagnostics::diagnostics;
 use crate::calibration::scale_factor::fit::fit;
 use crate::calibration::scale_factor::multipoint::Plateau;
-use crate::calibration::scale_factor::result::{Segment, SfFit};
+use crate::calibration::scale_factor::result::SfFit;
 use crate::calibration::thermal::summary::{calibrate, FitSummary};
 use crate::cli::args::{Json, NoReport, Out};
 use crate::cli::output::{print_json, write_report};
@@ -144,7 +144,7 @@ struct FitJson<'a> {
     knees_ci_c: Vec<[f64; 2]>,
     residual_ppm: f64,
     residual_ppm_se: f64,
-    segments: &'a [Segment],
+    /// The fit itself, `segments`, `model` and `degree` among its keys.
     #[serde(flatten)]
     fit: &'a SfFit,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -191,7 +191,6 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
             knees_ci_c: f.knees.iter().map(|k| [k.lo, k.hi]).collect(),
             residual_ppm: f.residual_ppm.value,
             residual_ppm_se: f.residual_ppm.se,
-            segments: &f.segments,
             fit: &f,
             plateaus: plateaus.as_deref(),
             table: TableJson {
