@@ -13,6 +13,11 @@ use core::num::NonZeroU32;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
 
+/// The DC filter's time constant, closures: the update's shift of its Q12
+/// state (`dc - dc >> 12 + flat`). The slowest loop of the closure: what
+/// starts with it (a run's first DC under vibration) decays at this rate.
+pub const DC_FILTER_CLOSURES: u32 = 1 << 12;
+
 /// Largest kept-sample sum of one half period, ADC LSB (15 kept samples of
 /// 16-bit codes), so the Q12 DC filter fits a u32.
 pub const MAX_HALF_SUM: u32 = (1 << 20) - 1;

@@ -270,22 +270,37 @@ impl RunText {
 }
 
 /// One column of a run file against time, streamed (the Allan analysis of
-/// `rate_dps` or any other column a user names): `t_s` increasing.
+/// `rate_dps` or any other column a user names): `t_s` increasing; the
+/// reference rate beside it where the file has one.
 pub struct Series {
     pub t_s: Vec<f64>,
     pub values: Vec<f64>,
+    pub reference: Option<Vec<f64>>,
     stream: ColumnStream,
 }
 
 impl Series {
     pub fn read(path: &Path, column: &str) -> Result<Self, LabError> {
-        let mut stream = ColumnStream::read(path, &[Column::Time.name(), column])?;
+        let reference = Column::RefRate.name();
+        let optional: &[&str] = if column == reference {
+            &[]
+        } else {
+            &[reference]
+        };
+        let (mut stream, present) =
+            ColumnStream::read_with(path, &[Column::Time.name(), column], optional)?;
         stream.check_increasing(0)?;
         let t_s = std::mem::take(&mut stream.data[0]);
         let values = std::mem::take(&mut stream.data[1]);
+        let reference = present
+            .first()
+            .copied()
+            .flatten()
+            .map(|k| std::mem::take(&mut stream.data[k]));
         Ok(Self {
             t_s,
             values,
+            reference,
             stream,
         })
     }
