@@ -43,45 +43,74 @@ pub fn not_static(reference_dps: &[f64]) -> Option<RecordWarning> {
 
 /// `too_short` when a term the fit reports dominates only averaging times
 /// with fewer than [`MIN_EDF`] degrees of freedom (the record's last few
-/// averages), or when no averaging time has that many.
+/// averages).
 pub fn too_short(an: &Allan) -> Option<RecordWarning> {
     let t = &an.terms;
-    let reported = |s: usize| match s {
-        SIN => t.sinusoid.is_some(),
-        MARKOV => t.correlated.is_some(),
-        j if j < COUNT => t.present[j],
-        _ => false,
-    };
-    let shapes: Vec<usize> = (0..COUNT)
-        .chain([SIN, MARKOV])
-        .filter(|&s| reported(s))
+    let reported: Vec<usize> = (0..COUNT)
+        .filter(|&j| t.present[j])
+        .chain(t.sinusoid.as_ref().map(|_| SIN))
+        .chain(t.correlated.as_ref().map(|_| MARKOV))
         .collect();
-    let unsupported: Vec<&str> = shapes
-        .iter()
-        .filter(|&&s| {
-            let dominated: Vec<f64> = t
-                .dominant
-                .iter()
-                .zip(&t.edf)
-                .filter(|(&d, _)| d == s)
-                .map(|(_, &e)| e)
-                .collect();
-            !dominated.is_empty() && dominated.iter().all(|&e| e < MIN_EDF)
-        })
-        .map(|&s| shape_name(s))
-        .collect();
+    let unsupported = unsupported_terms(&reported, &t.dominant, &t.edf);
     if unsupported.is_empty() {
         return None;
     }
     let duration = an.n as f64 * an.tau0;
+    let (them, mean) = if unsupported.len() == 1 {
+        ("it", "its value and interval mean")
+    } else {
+        ("them", "their values and intervals mean")
+    };
+    let names: Vec<&str> = unsupported.iter().map(|&s| shape_name(s)).collect();
     Some(RecordWarning {
         code: "too_short",
         message: format!(
-            "the record ({duration:.4} s, {} samples) is too short to show {}: the fit reads \
-             them only at its longest averaging times, from fewer than {MIN_EDF:.0} degrees of \
-             freedom; their values and intervals mean little. A record ten times longer would show them",
+            "the record ({} s, {} samples) is too short to show {}: the fit reads {them} only at \
+             its longest averaging times, from fewer than {MIN_EDF:.0} degrees of freedom, and {mean} \
+             little. A record ten times longer would show {them}",
+            crate::report::text::sig(duration),
             an.n,
-            unsupported.join(", ")
+            names.join(", ")
         ),
     })
+}
+
+/// Of the `reported` shapes, those that dominate some averaging time but
+/// only ones with fewer than [`MIN_EDF`] degrees of freedom (`dominant`
+/// and `edf` per averaging time).
+pub fn unsupported_terms(reported: &[usize], dominant: &[usize], edf: &[f64]) -> Vec<usize> {
+    reported
+        .iter()
+        .copied()
+        .filter(|&s| {
+            let mut dominated = dominant.iter().zip(edf).filter(|(&d, _)| d == s).peekable();
+            dominated.peek().is_some() && dominated.all(|(_, &e)| e < MIN_EDF)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ramp (shape 4) that carries only the last three averages (EDF 3.8,
+    /// 2.5, 1.6) is unsupported; one that carries averages with 9.5 and 6.7
+    /// degrees of freedom as well is shown; white noise (1) over the rest is.
+    #[test]
+    fn a_term_read_only_at_the_last_averages_is_unsupported() {
+        let edf = [200.0, 80.0, 30.0, 9.5, 6.7, 3.8, 2.5, 1.6];
+        let tail = [1, 1, 1, 1, 1, 4, 4, 4];
+        assert_eq!(unsupported_terms(&[1, 4], &tail, &edf), vec![4]);
+        let wide = [1, 1, 1, 4, 4, 4, 4, 4];
+        assert!(unsupported_terms(&[1, 4], &wide, &edf).is_empty());
+        // A reported term that dominates nowhere is not judged here.
+        assert!(unsupported_terms(&[1, 3], &tail, &edf).is_empty());
+    }
+
+    #[test]
+    fn a_turning_reference_is_not_static() {
+        assert!(not_static(&[0.004178; 100]).is_none());
+        let table: Vec<f64> = (0..100).map(|k| if k < 50 { 0.0 } else { 10.0 }).collect();
+        assert_eq!(not_static(&table).unwrap().code, "not_static");
+    }
 }
