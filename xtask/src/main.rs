@@ -23,8 +23,10 @@ fn main() {
         Some("record-test") => record_test_cmd(),
         // The interrupt handlers' freedom from panics (part of `test`).
         Some("isr-proof") => isr_proof_cmd(),
+        // The README's lab walkthrough, top to bottom (part of `test`).
+        Some("readme") => readme_cmd(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu|test|bench|record-test|isr-proof>");
+            eprintln!("usage: cargo xtask <qemu|test|bench|record-test|isr-proof|readme>");
             std::process::exit(2);
         }
     };
@@ -265,7 +267,14 @@ fn test_cmd() -> Result<()> {
     if failed > 0 {
         bail!("{failed} firmware test(s) under QEMU failed");
     }
-    record_tests(&qrun)
+    record_tests(&qrun)?;
+    readme_cmd()
+}
+
+/// `cargo xtask readme`: the README's "The lab, step by step", every
+/// command as written, in a scratch folder (scripts/readme-walkthrough.sh).
+fn readme_cmd() -> Result<()> {
+    run(Command::new("sh").arg(root().join("scripts/readme-walkthrough.sh")))
 }
 
 /// The interrupts that must exist in the hw image: the FOG closure (ADC
