@@ -8,6 +8,7 @@
 #   scripts/readme-walkthrough.sh [--keep]
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$root/target"
 work=$(mktemp -d "$root/target/readme-walkthrough.XXXXXX")
 [ "${1:-}" = "--keep" ] || trap 'rm -rf "$work"' EXIT
 # The section's shell blocks, up to the benchmarks.
