@@ -1,117 +1,77 @@
-//! `gyro-lab record` as it will be used: the firmware under QEMU with its
-//! USART on a pseudo-terminal, read by the recorder as a USB-serial adapter
+//! `gyro-lab record` as it will be used: the firmware under QEMU, its USART
+//! bytes on a pseudo-terminal read by the recorder as a USB-serial adapter
 //! would be; then the same through a relay that damages the stream, with
 //! the damage known; then the lab's analyses on what was recorded.
 //!
-//! QEMU starts halted (-S) and is told to run (`cont` on its monitor) only
-//! once the reader holds the terminal (seen in /proc, not guessed by a
-//! sleep): QEMU's pty backend drops output while nobody has the other side
-//! open.
+//! The harness owns the pseudo-terminal. QEMU's USART goes to a Unix
+//! socket (`-serial unix:...,server=on,wait=on`: the guest starts only once
+//! the harness is connected, after the recorder holds its terminal, seen in
+//! /proc); a bridge thread copies the socket to the terminal, damaging the
+//! stream by plan in the relay test, and closes the terminal only once the
+//! recorder has every byte it was given. QEMU's own pty backend drops what
+//! it writes while nobody holds the other side, and the kernel discards
+//! what a reader has not yet read when QEMU exits and closes it: a slow
+//! reader on a loaded host lost the stream's last frames that way. A socket
+//! loses nothing, and a full one blocks the guest (its clock stands still,
+//! `-icount ... sleep=off`), as a full adapter would.
 
 use crate::capture::{self, FRAME};
 use crate::{qemu_command, root, wait_progressing, QEMU_STALL};
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeSet;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
+use std::os::unix::net::UnixStream;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// How long a reader may take to open its pty (a loaded host starts
-/// processes slowly; QEMU stays halted meanwhile).
+/// How long a reader may take to open its pty, QEMU to make its socket, or
+/// the recorder to take the bytes it was given (a loaded host is slow; the
+/// guest waits meanwhile).
 const READER_WAIT: Duration = Duration::from_secs(60);
 
-/// A QEMU run halted at start with its serial port on a new pty.
-struct PtyQemu {
+/// A QEMU run waiting for its serial socket's client.
+struct SocketQemu {
     child: Child,
-    pts: PathBuf,
-    monitor: PathBuf,
+    socket: PathBuf,
     log: PathBuf,
 }
 
-fn start_qemu_on_pty(elf: &Path, dir: &Path) -> Result<PtyQemu> {
+fn start_qemu_on_socket(elf: &Path, dir: &Path) -> Result<SocketQemu> {
     std::fs::create_dir_all(dir)?;
-    let monitor = dir.join("monitor.sock");
-    let _ = std::fs::remove_file(&monitor);
+    let socket = dir.join("serial.sock");
+    let _ = std::fs::remove_file(&socket);
     let log = dir.join("defmt.bin");
-    let mut cmd = qemu_command(elf, "pty");
-    // Halted until `cont`, with a monitor socket to say it on.
-    let args: Vec<String> = cmd
-        .get_args()
-        .map(|a| a.to_string_lossy().into_owned())
-        .collect();
-    let mut c = Command::new(cmd.get_program());
-    let mut it = args.iter().peekable();
-    while let Some(a) = it.next() {
-        if a == "-monitor" {
-            it.next();
-            c.arg("-monitor")
-                .arg(format!("unix:{},server=on,wait=off", monitor.display()));
-        } else {
-            c.arg(a);
-        }
-    }
-    c.arg("-S");
-    cmd = c;
-    let mut child = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("starting qemu-system-arm")?;
-    // "char device redirected to /dev/pts/N (label serial0)": QEMU says it
-    // on stdout or stderr before the halted guest writes anything. Stdout
-    // then carries the guest's defmt log (to `log`); stderr is drained.
-    let (tx, rx) = std::sync::mpsc::channel::<PathBuf>();
-    let stdout = child.stdout.take().context("QEMU's stdout")?;
-    let stderr = child.stderr.take().context("QEMU's stderr")?;
-    let mut log_file = std::fs::File::create(&log)?;
-    let tx2 = tx.clone();
-    std::thread::spawn(move || {
-        let mut r = BufReader::new(stdout);
-        let mut line = String::new();
-        while r.read_line(&mut line).unwrap_or(0) > 0 {
-            if let Some(p) = pts_of(&line) {
-                let _ = tx.send(p);
-                break;
-            }
-            line.clear();
-        }
-        let _ = std::io::copy(&mut r, &mut log_file);
-    });
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            if let Some(p) = pts_of(&line) {
-                let _ = tx2.send(p);
-            }
-        }
-    });
-    let pts = match rx.recv_timeout(Duration::from_secs(30)) {
-        Ok(p) => p,
-        Err(_) => {
-            let _ = child.kill();
-            bail!("QEMU did not name its pty within 30 s");
-        }
-    };
-    Ok(PtyQemu {
-        child,
-        pts,
-        monitor,
-        log,
-    })
+    let child = qemu_command(
+        elf,
+        &format!("unix:{},server=on,wait=on", socket.display()),
+    )
+    .stdout(std::fs::File::create(&log)?)
+    .stderr(Stdio::null())
+    .spawn()
+    .context("starting qemu-system-arm")?;
+    Ok(SocketQemu { child, socket, log })
 }
 
-/// The pty in QEMU's "char device redirected to /dev/pts/N" line.
-fn pts_of(line: &str) -> Option<PathBuf> {
-    let rest = line.split("redirected to ").nth(1)?;
-    Some(PathBuf::from(rest.split_whitespace().next()?))
+/// Connects to QEMU's serial socket (QEMU makes it at start; the guest
+/// runs from the connection on).
+fn connect(socket: &Path) -> Result<UnixStream> {
+    let start = Instant::now();
+    loop {
+        match UnixStream::connect(socket) {
+            Ok(s) => return Ok(s),
+            Err(e) if start.elapsed() > READER_WAIT => {
+                bail!("QEMU's serial socket {}: {e}", socket.display())
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    }
 }
 
 /// Waits until process `pid` holds `path` open (a reader on a pty), for at
 /// most `limit`. A fixed sleep is not enough: on a loaded host the reader
-/// can start later than any guess, and QEMU's pty drops what it writes
-/// while nobody holds the other side.
+/// can start later than any guess.
 fn wait_open(pid: u32, path: &Path, limit: Duration) -> Result<()> {
     let start = Instant::now();
     let dir = PathBuf::from(format!("/proc/{pid}/fd"));
@@ -133,16 +93,6 @@ fn wait_open(pid: u32, path: &Path, limit: Duration) -> Result<()> {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-}
-
-/// Tells the halted QEMU to run (its readers hold their ptys by then).
-fn cont(monitor: &Path) -> Result<()> {
-    let mut s = std::os::unix::net::UnixStream::connect(monitor)
-        .with_context(|| format!("QEMU monitor {}", monitor.display()))?;
-    s.write_all(b"cont\n")?;
-    // Keep the connection until QEMU has read it.
-    std::thread::sleep(Duration::from_millis(200));
-    Ok(())
 }
 
 /// Runs `gyro-lab record --port <pts>` into `out`; returns the child.
@@ -295,36 +245,36 @@ fn damage_frame(k: usize, frame: &mut Vec<u8>, out: &mut Vec<u8>, d: &mut Damage
     true
 }
 
-/// Copies QEMU's pty to `master`, damaging it by plan, with a stall of a
-/// few seconds in the middle; what it read from QEMU goes to `seen` too.
-/// Says on `opened` when it holds QEMU's pty; ends when QEMU's side closes.
+/// Copies QEMU's serial socket to `master`, damaging it by plan when
+/// `damage` (with a stall of a few seconds in the middle); what it read
+/// goes to `seen` too. At the socket's end (QEMU exited) it waits until the
+/// recorder's capture `taken` holds every byte written, then returns,
+/// closing the terminal: the recorder then sees the port go away.
 fn relay(
-    qemu_pts: PathBuf,
+    mut input: UnixStream,
     master: OwnedFd,
     seen: PathBuf,
-    opened: std::sync::mpsc::Sender<()>,
+    damage: bool,
+    taken: PathBuf,
 ) -> Result<Damage> {
-    let input = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(&qemu_pts)
-        .with_context(|| format!("{}", qemu_pts.display()))?;
-    raw_mode(input.as_raw_fd())?;
-    let _ = opened.send(());
-    let mut input = input;
-    let mut seen = std::fs::File::create(&seen)?;
     let mut output = std::fs::File::from(master);
+    let mut seen = std::fs::File::create(&seen)?;
     let mut d = Damage::default();
-    let (mut pending, mut k) = (Vec::new(), 0usize);
+    let (mut pending, mut k, mut written) = (Vec::new(), 0usize, 0u64);
     let mut buf = [0u8; 4096];
     loop {
         let n = match input.read(&mut buf) {
             Ok(0) => break,
             Ok(n) => n,
-            // EIO: QEMU closed its side.
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(_) => break,
         };
         seen.write_all(&buf[..n])?;
+        if !damage {
+            output.write_all(&buf[..n])?;
+            written += n as u64;
+            continue;
+        }
         pending.extend_from_slice(&buf[..n]);
         let mut out = Vec::new();
         while pending.len() >= FRAME {
@@ -335,6 +285,7 @@ fn relay(
             if k == 600 {
                 // A stall: the cable hangs for three seconds.
                 output.write_all(&out)?;
+                written += out.len() as u64;
                 out.clear();
                 std::thread::sleep(Duration::from_secs(3));
                 d.stall_s = 3.0;
@@ -342,9 +293,53 @@ fn relay(
             k += 1;
         }
         output.write_all(&out)?;
+        written += out.len() as u64;
     }
     output.write_all(&pending)?;
+    written += pending.len() as u64;
+    let start = Instant::now();
+    while std::fs::metadata(&taken).map_or(0, |m| m.len()) < written {
+        if start.elapsed() > READER_WAIT {
+            bail!(
+                "the recorder took {} of the {written} bytes given in {} s",
+                std::fs::metadata(&taken).map_or(0, |m| m.len()),
+                READER_WAIT.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
     Ok(d)
+}
+
+/// One record through the bridge: QEMU on its socket, the harness's pty,
+/// the recorder on it (holding it before the guest starts), the relay
+/// between them. Returns what the relay did and the recorder's exit
+/// status, JSON line and stderr.
+fn record_through(
+    elf: &Path,
+    lab: &Path,
+    dir: &Path,
+    reference: &Path,
+    damage: bool,
+) -> Result<(Damage, i32, serde_json::Value, String)> {
+    let q = start_qemu_on_socket(elf, dir)?;
+    let (master, pts) = open_pty()?;
+    let out = dir.join("record");
+    let rec = start_recorder(lab, &pts, &out, reference)?;
+    wait_open(rec.id(), &pts, READER_WAIT)?;
+    let input = connect(&q.socket)?;
+    let (seen, taken) = (dir.join("relay-in.bin"), out.join("raw.bin"));
+    let relay = std::thread::spawn(move || relay(input, master, seen, damage, taken));
+    let mut child = q.child;
+    wait_progressing(&mut child, &[&out.join("raw.bin"), &q.log], QEMU_STALL)?;
+    let d = relay
+        .join()
+        .map_err(|_| anyhow::anyhow!("the relay panicked"))??;
+    let (code, json, stderr) = finish_recorder(rec)?;
+    if !out.join("fog.csv").exists() {
+        bail!("gyro-lab record wrote nothing (exit {code}): {stderr}");
+    }
+    Ok((d, code, json, stderr))
 }
 
 /// Frames of the clean stream that `path` (bytes a harness stage passed
@@ -377,17 +372,8 @@ pub fn run(
 
     // 1. QEMU's USART on a pty, read by `gyro-lab record --port`.
     let dir = root().join("runs/pty");
-    let q = start_qemu_on_pty(elf, &dir)?;
     let out = dir.join("record");
-    let rec = start_recorder(&lab, &q.pts, &out, reference)?;
-    wait_open(rec.id(), &q.pts, READER_WAIT)?;
-    cont(&q.monitor)?;
-    let mut child = q.child;
-    wait_progressing(&mut child, &[&out.join("raw.bin"), &q.log], QEMU_STALL)?;
-    let (code, json, stderr) = finish_recorder(rec)?;
-    if !out.join("fog.csv").exists() {
-        bail!("gyro-lab record wrote nothing (exit {code}): {stderr}");
-    }
+    let (_, code, json, stderr) = record_through(elf, &lab, &dir, reference, false)?;
     let v = capture::judge(clean_bin, clean, &out, &json)?;
     let identical = std::fs::read(out.join("raw.bin"))? == std::fs::read(clean_bin)?;
     let went_away = code == 2 && stderr.contains("the port went away");
@@ -401,7 +387,7 @@ pub fn run(
                 "bytes identical to the file path's".to_string()
             } else {
                 format!(
-                    "the pty delivered {} frames short (harness loss, reported exactly: {})",
+                    "the harness delivered {} frames short (its loss, reported exactly: {})",
                     v.not_received.len(),
                     v.exact
                 )
@@ -416,29 +402,9 @@ pub fn run(
 
     // 2. The same through a relay that damages the stream.
     let dir = root().join("runs/relay");
-    let q = start_qemu_on_pty(elf, &dir)?;
-    let (master, relay_pts) = open_pty()?;
     let out = dir.join("record");
-    let rec = start_recorder(&lab, &relay_pts, &out, reference)?;
-    let qemu_pts = q.pts.clone();
+    let (damage, code, json, stderr) = record_through(elf, &lab, &dir, reference, true)?;
     let seen = dir.join("relay-in.bin");
-    let (opened_tx, opened) = std::sync::mpsc::channel();
-    let seen2 = seen.clone();
-    let relay = std::thread::spawn(move || relay(qemu_pts, master, seen2, opened_tx));
-    wait_open(rec.id(), &relay_pts, READER_WAIT)?;
-    opened
-        .recv_timeout(READER_WAIT)
-        .context("the relay did not open QEMU's pty")?;
-    cont(&q.monitor)?;
-    let mut child = q.child;
-    wait_progressing(&mut child, &[&out.join("raw.bin"), &q.log], QEMU_STALL)?;
-    let damage = relay
-        .join()
-        .map_err(|_| anyhow::anyhow!("the relay panicked"))??;
-    let (code, json, stderr) = finish_recorder(rec)?;
-    if !out.join("fog.csv").exists() {
-        bail!("gyro-lab record wrote nothing (exit {code}): {stderr}");
-    }
     let v = capture::judge(clean_bin, clean, &out, &json)?;
     let upstream = harness_lost(clean_bin, &seen)?;
     let lost = json["lost_frame_count"].as_u64().unwrap_or(u64::MAX);
@@ -464,7 +430,7 @@ pub fn run(
                 String::new()
             } else {
                 format!(
-                    " and {} lost by the pty before the relay (harness loss, frames {:?})",
+                    " and {} lost before the relay (harness loss, frames {:?})",
                     upstream.len(),
                     upstream
                 )
