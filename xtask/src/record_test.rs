@@ -20,8 +20,8 @@ use crate::{qemu_command, root, wait_progressing, QEMU_STALL};
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeSet;
 use std::io::{Read, Write};
-use std::os::unix::net::UnixStream;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -43,14 +43,11 @@ fn start_qemu_on_socket(elf: &Path, dir: &Path) -> Result<SocketQemu> {
     let socket = dir.join("serial.sock");
     let _ = std::fs::remove_file(&socket);
     let log = dir.join("defmt.bin");
-    let child = qemu_command(
-        elf,
-        &format!("unix:{},server=on,wait=on", socket.display()),
-    )
-    .stdout(std::fs::File::create(&log)?)
-    .stderr(Stdio::null())
-    .spawn()
-    .context("starting qemu-system-arm")?;
+    let child = qemu_command(elf, &format!("unix:{},server=on,wait=on", socket.display()))
+        .stdout(std::fs::File::create(&log)?)
+        .stderr(Stdio::null())
+        .spawn()
+        .context("starting qemu-system-arm")?;
     Ok(SocketQemu { child, socket, log })
 }
 
