@@ -185,3 +185,23 @@ fn a_missing_column_names_the_header_line() {
         assert!(err.contains("missing column `rate_dps`"), "{args:?}: {err}");
     }
 }
+
+/// A finite value no gyro, table or sensor gives (1e300 deg/s, 5000 degC)
+/// is refused at its cell: summed, it would turn every answer into
+/// infinity or nothing.
+#[test]
+fn values_no_instrument_gives_are_refused_at_their_cell() {
+    let rows = run_rows(400);
+    let mut lines: Vec<&str> = rows.lines().collect();
+    lines[30] = "30,0.0041781,1e300,20.3,20.3,20.4,20.3";
+    let huge = write("huge.csv", &format!("{RUN_HEADER}{}\n", lines.join("\n")));
+    let out = std::env::temp_dir().join(format!("gyro-lab-huge-{}", std::process::id()));
+    let out = out.display().to_string();
+    for cmd in commands(&huge, &out).into_iter().take(5) {
+        let args: Vec<&str> = cmd.iter().map(String::as_str).collect();
+        let (code, err) = lab(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(&format!("{huge}:32:3")), "{args:?}: {err}");
+        assert!(err.contains("outside the rates"), "{args:?}: {err}");
+    }
+}

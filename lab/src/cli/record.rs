@@ -6,10 +6,11 @@
 
 use crate::cli::args::{Json, Out};
 use crate::cli::output::print_json;
-use crate::data::run_file::Column;
+use crate::data::run_file::{self, Column};
 use crate::data::table::TextTable;
 use crate::error::LabError;
 use clap::Args;
+use gyro_frames::reference::RateLogError;
 use gyro_frames::summary::Summary;
 use gyro_frames::{RateLog, RecordError, Recorder, Reference, Scales};
 use serde::Serialize;
@@ -211,12 +212,24 @@ fn reference(a: &RecordArgs) -> Result<Reference, LabError> {
     let Some(path) = &a.reference else {
         return Ok(Reference::Constant(0.0));
     };
-    let t = TextTable::read(path)?;
+    let t = TextTable::read_bounded(path, Some(run_file::bounds))?;
     let time = t.time(Column::Time.name(), 2)?;
     let rate = t.column(Column::RefRate.name())?;
     RateLog::new(time, rate, a.reference_offset_s)
         .map(Reference::Log)
-        .map_err(|e| LabError::input(path, format!("{e:?}")))
+        .map_err(|e| {
+            LabError::input(
+                path,
+                match e {
+                    RateLogError::TooShort => "fewer than two reference samples".to_string(),
+                    RateLogError::NotIncreasing { index } => {
+                        format!(
+                            "reference sample {index} is not after the one before, or not finite"
+                        )
+                    }
+                },
+            )
+        })
 }
 
 fn record_error(e: RecordError, source: &Path) -> LabError {

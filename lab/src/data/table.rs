@@ -15,11 +15,17 @@
 use crate::error::{ColumnRef, LabError};
 use std::path::{Path, PathBuf};
 
+/// The physical range of a column's values, looked up by its name (the
+/// file kinds know their columns; this module knows none): `(lo, hi,
+/// what)`, `what` naming the range in the error.
+pub type Bounds = fn(&str) -> Option<(f64, f64, &'static str)>;
+
 /// What is wrong with a cell that should hold a number.
 enum CellError<'a> {
     NotFinite(&'a str),
     Empty,
     NotANumber(&'a str),
+    OutOfRange(&'a str, &'static str),
 }
 
 impl std::fmt::Display for CellError<'_> {
@@ -28,14 +34,23 @@ impl std::fmt::Display for CellError<'_> {
             CellError::NotFinite(c) => write!(f, "`{c}` is not a finite number"),
             CellError::Empty => f.write_str("empty cell"),
             CellError::NotANumber(c) => write!(f, "cannot read `{c}` as a number"),
+            CellError::OutOfRange(c, what) => write!(f, "`{c}` is outside {what}"),
         }
     }
 }
 
-/// A cell as a finite number.
-fn number(cell: &str) -> Result<f64, CellError<'_>> {
+/// A cell as a finite number, within `range` where the column has one.
+fn number<'a>(
+    cell: &'a str,
+    range: Option<(f64, f64, &'static str)>,
+) -> Result<f64, CellError<'a>> {
     match cell.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_finite() => match range {
+            Some((lo, hi, what)) if !(lo..=hi).contains(&v) => {
+                Err(CellError::OutOfRange(cell, what))
+            }
+            _ => Ok(v),
+        },
         Ok(_) => Err(CellError::NotFinite(cell)),
         Err(_) if cell.is_empty() => Err(CellError::Empty),
         Err(_) => Err(CellError::NotANumber(cell)),
@@ -91,10 +106,16 @@ pub struct TextTable {
     pub header: Vec<String>,
     header_line: u64,
     rows: Vec<(u64, Vec<String>)>,
+    bounds: Option<Bounds>,
 }
 
 impl TextTable {
     pub fn read(path: &Path) -> Result<Self, LabError> {
+        Self::read_bounded(path, None)
+    }
+
+    /// Reads, checking every numeric column's cells against `bounds`.
+    pub fn read_bounded(path: &Path, bounds: Option<Bounds>) -> Result<Self, LabError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
         // Comment lines before the header are skipped by hand so that line
@@ -132,6 +153,7 @@ impl TextTable {
             header,
             header_line,
             rows,
+            bounds,
         })
     }
 
@@ -170,11 +192,12 @@ impl TextTable {
     /// A numeric column: every cell a finite number.
     pub fn column(&self, col: &str) -> Result<Vec<f64>, LabError> {
         let i = self.index(col)?;
+        let range = self.bounds.and_then(|b| b(col));
         self.rows
             .iter()
             .map(|(line, cells)| {
                 let cell = cells.get(i).map(String::as_str).unwrap_or("");
-                number(cell).map_err(|m| {
+                number(cell, range).map_err(|m| {
                     LabError::at(&self.path, *line, column_ref(i + 1, col), m.to_string())
                 })
             })
@@ -280,6 +303,16 @@ impl ColumnStream {
         required: &[&str],
         optional: &[&str],
     ) -> Result<(Self, Vec<Option<usize>>), LabError> {
+        Self::read_bounded(path, required, optional, None)
+    }
+
+    /// [`Self::read_with`], every cell checked against `bounds`.
+    pub fn read_bounded(
+        path: &Path,
+        required: &[&str],
+        optional: &[&str],
+        bounds: Option<Bounds>,
+    ) -> Result<(Self, Vec<Option<usize>>), LabError> {
         let mut file = std::io::BufReader::with_capacity(
             1 << 20,
             std::fs::File::open(path)
@@ -327,6 +360,7 @@ impl ColumnStream {
                 None => present.push(None),
             }
         }
+        let ranges: Vec<_> = cols.iter().map(|c| bounds.and_then(|b| b(c))).collect();
         let mut data: Vec<Vec<f64>> = cols.iter().map(|_| Vec::new()).collect();
         let mut lines = Vec::new();
         while rdr.read_byte_record(&mut rec).map_err(at)? {
@@ -342,7 +376,7 @@ impl ColumnStream {
             for (k, &f) in fields.iter().enumerate() {
                 let cell = rec.get(f - 1).unwrap_or(b"").trim_ascii();
                 let text = std::str::from_utf8(cell).unwrap_or("");
-                let v = number(text)
+                let v = number(text, ranges[k])
                     .map_err(|m| LabError::at(path, line, column_ref(f, cols[k]), m.to_string()))?;
                 data[k].push(v);
             }
