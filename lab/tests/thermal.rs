@@ -238,26 +238,21 @@ fn reports_and_their_warnings() {
     // The soak's coefficients on the cycle: the run leaves the one
     // temperature the fit saw, and the compensation report says where.
     std::fs::create_dir_all(d.join("sc")).unwrap();
-    let v = lab_json(&[
-        "compensate",
-        "--coeffs",
-        &p("s/c.toml"),
-        "--data",
-        &p("fit.csv"),
-        "--out",
-        &p("sc/comp.csv"),
-    ]);
+    let soak_on_cycle = |out: &str| {
+        lab_json(&[
+            "compensate",
+            "--coeffs",
+            &p("s/c.toml"),
+            "--data",
+            &p("fit.csv"),
+            "--out",
+            &p(out),
+        ])
+    };
+    let v = soak_on_cycle("sc/comp.csv");
     let html = std::fs::read_to_string(d.join("sc").join("comp.html")).unwrap();
     // The fit's report in the same folder as another command's survives.
-    lab_json(&[
-        "compensate",
-        "--coeffs",
-        &p("s/c.toml"),
-        "--data",
-        &p("fit.csv"),
-        "--out",
-        &p("s/comp.csv"),
-    ]);
+    soak_on_cycle("s/comp.csv");
     assert!(d.join("s").join("c.html").exists() && d.join("s").join("comp.html").exists());
     report_check::check(&html, &v, 2, 8);
     let kinds = report_check::assert_warnings_match(&html, &v);

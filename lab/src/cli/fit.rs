@@ -84,15 +84,7 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
     } else {
         let v = s.coefficients.values();
         let e = s.coefficient_se.map(|c| c.values());
-        let names = [
-            "bias0_dph",
-            "k1_dph_per_c",
-            "k2_dph_per_c_per_s",
-            "k3_dph_per_c2",
-            "k4_dph_per_c",
-            "k5_dph",
-            "tau_warm_s",
-        ];
+        let names = gyro_sp::rlg::ThermalCoeffs::NAMES;
         for (k, n) in names.iter().enumerate() {
             match e {
                 Some(e) => println!("  {n:<20} {:>12.6} +- {:.6}", v[k], e[k]),

@@ -83,14 +83,7 @@ impl std::fmt::Display for ThermalFitError {
                  monoblock over {span_mono_c:.2} degC and the case over {span_case_c:.2} degC; {WHAT_TO_DO}"
             ),
             ThermalFitError::OutOfRange(_, c) => {
-                let names = [
-                    "bias0_dph",
-                    "k1_dph_per_c",
-                    "k2_dph_per_c_per_s",
-                    "k3_dph_per_c2",
-                    "k4_dph_per_c",
-                    "k5_dph",
-                ];
+                let names = ThermalCoeffs::NAMES;
                 let v = c.values();
                 let worst = (0..6)
                     .max_by(|&i, &j| v[i].abs().total_cmp(&v[j].abs()))
