@@ -6,6 +6,7 @@
 //! is an error at the place in the formula that made it.
 
 use super::parse::{Expr, Func, Node, Op};
+use crate::data::run_file::Column;
 use crate::model::discovery::terms::curvature;
 use crate::model::inputs::centered_slope;
 use std::collections::BTreeMap;
@@ -19,21 +20,21 @@ pub const DDT_HALF_WIDTH_S: f64 = 30.0;
 /// side, and a local cubic's curvature near the record's ends.
 pub const D2DT2_HALF_WIDTH_S: f64 = 120.0;
 
-/// The columns a formula may name: the run's inputs. Not `rate_dps` or
-/// `angle_deg`: a model predicts those.
-pub const INPUT_COLUMNS: [&str; 7] = [
-    "t_s",
-    "ref_rate_dps",
-    "temp_c",
-    "t_mono_a_c",
-    "t_mono_b_c",
-    "t_case_c",
-    "ref_acc_dps2",
+/// The columns a formula may name: the run's inputs. Not the output
+/// (`rate_dps`, the angle): a model predicts those.
+pub const INPUT_COLUMNS: [Column; 7] = [
+    Column::Time,
+    Column::RefRate,
+    Column::Temp,
+    Column::MonoA,
+    Column::MonoB,
+    Column::Case,
+    Column::RefAcc,
 ];
 
 /// What a formula is evaluated with.
 pub struct Env<'a> {
-    /// The run's input columns present, by name (`t_s` among them).
+    /// The run's input columns present, by name (time among them).
     pub columns: &'a BTreeMap<&'a str, &'a [f64]>,
     /// The term's parameters.
     pub params: &'a BTreeMap<String, f64>,
@@ -101,10 +102,11 @@ pub fn names(n: &Node) -> Vec<(String, Range<usize>)> {
 
 /// The formula's value on every row of a run of `rows` rows, deg/h.
 pub fn evaluate(n: &Node, env: &Env, rows: usize) -> Result<Vec<f64>, EvalError> {
-    let t = env.columns.get("t_s").copied().unwrap_or(&[]);
+    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
     let at = |k: usize| {
-        t.get(k)
-            .map_or(String::new(), |t| format!(" (at t_s = {t})"))
+        t.get(k).map_or(String::new(), |t| {
+            format!(" (at {} = {t})", Column::Time.name())
+        })
     };
     let v = eval(n, env, &at)?;
     if let Some(k) = v.first(|x| !x.is_finite()) {
@@ -177,7 +179,7 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
                 }
                 Func::Step => a.map(|v| if v >= 0.0 { 1.0 } else { 0.0 }),
                 Func::Ddt | Func::D2dt2 => {
-                    let t = env.columns.get("t_s").copied().unwrap_or(&[]);
+                    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
                     let row = match a {
                         // The derivative of a constant.
                         Val::All(_) => return Ok(Val::All(0.0)),
@@ -206,9 +208,9 @@ fn pow(x: f64, y: f64) -> f64 {
 fn unknown_name(s: &str, env: &Env) -> String {
     let cols: Vec<&str> = env.columns.keys().copied().collect();
     let params: Vec<&str> = env.params.keys().map(String::as_str).collect();
-    let why = if INPUT_COLUMNS.contains(&s) {
+    let why = if INPUT_COLUMNS.iter().any(|c| c.name() == s) {
         format!("the run has no column `{s}`")
-    } else if s == "rate_dps" || s == "angle_deg" {
+    } else if s == Column::Rate.name() || s == Column::Angle.name() {
         format!("`{s}` is the gyro's output, which the model predicts: a term is built from the run's inputs")
     } else {
         format!("unknown name `{s}`")
@@ -229,13 +231,23 @@ mod tests {
     use super::super::parse::parse;
     use super::*;
 
+    /// The formula with the columns' names put in: `{t}` time, `{w}` the
+    /// reference rate, `{T}` the coil temperature, `{y}` the output.
+    fn f(s: &str) -> String {
+        s.replace("{t}", Column::Time.name())
+            .replace("{w}", Column::RefRate.name())
+            .replace("{T}", Column::Temp.name())
+            .replace("{y}", Column::Rate.name())
+    }
+
     fn run(
         formula: &str,
-        cols: &[(&'static str, Vec<f64>)],
+        cols: &[(Column, Vec<f64>)],
         params: &[(&str, f64)],
     ) -> Result<Vec<f64>, EvalError> {
-        let n = parse(formula).unwrap();
-        let owned: BTreeMap<&str, &[f64]> = cols.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+        let n = parse(&f(formula)).unwrap();
+        let owned: BTreeMap<&str, &[f64]> =
+            cols.iter().map(|(k, v)| (k.name(), v.as_slice())).collect();
         let p: BTreeMap<String, f64> = params.iter().map(|(k, v)| (k.to_string(), *v)).collect();
         let rows = cols.first().map_or(1, |c| c.1.len());
         evaluate(
@@ -253,20 +265,20 @@ mod tests {
         let t: Vec<f64> = (0..5).map(|k| k as f64).collect();
         let w = vec![-2.0, -1.0, 0.0, 1.0, 2.0];
         let y = run(
-            "k_dph * ref_rate_dps^2 + c * abs(ref_rate_dps) * step(t_s - 2)",
-            &[("t_s", t.clone()), ("ref_rate_dps", w.clone())],
+            "k_dph * {w}^2 + c * abs({w}) * step({t} - 2)",
+            &[(Column::Time, t.clone()), (Column::RefRate, w.clone())],
             &[("k_dph", 0.5), ("c", 3.0)],
         )
         .unwrap();
         assert_eq!(y, vec![2.0, 0.5, 0.0, 3.5, 8.0]);
-        let y = run("2^3^2 - -1 + pi * 0", &[("t_s", t.clone())], &[]).unwrap();
+        let y = run("2^3^2 - -1 + pi * 0", &[(Column::Time, t.clone())], &[]).unwrap();
         assert_eq!(y, vec![513.0; 5]);
         // ddt of a line is its slope; d2dt2 of a parabola its curvature.
         let t: Vec<f64> = (0..2000).map(|k| k as f64).collect();
         let x: Vec<f64> = t.iter().map(|t| 3.0 + 0.01 * t + 1e-6 * t * t).collect();
         let d = run(
-            "ddt(temp_c)",
-            &[("t_s", t.clone()), ("temp_c", x.clone())],
+            "ddt({T})",
+            &[(Column::Time, t.clone()), (Column::Temp, x.clone())],
             &[],
         )
         .unwrap();
@@ -275,28 +287,41 @@ mod tests {
             "{}",
             d[1000]
         );
-        let c = run("d2dt2(temp_c)", &[("t_s", t.clone()), ("temp_c", x)], &[]).unwrap();
+        let c = run(
+            "d2dt2({T})",
+            &[(Column::Time, t.clone()), (Column::Temp, x)],
+            &[],
+        )
+        .unwrap();
         assert!(c.iter().all(|c| (c - 2e-6).abs() < 1e-9), "{:?}", &c[..3]);
     }
 
     #[test]
     fn errors_at_the_place_that_made_them() {
         let t: Vec<f64> = (0..5).map(|k| k as f64).collect();
-        let e = run("k / (t_s - 2)", &[("t_s", t.clone())], &[("k", 1.0)]).unwrap_err();
+        let e = run("k / ({t} - 2)", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
         assert_eq!(e.span, 4..13);
-        assert!(e.msg.contains("divides by zero (at t_s = 2)"), "{}", e.msg);
-        let e = run("k * temp_c", &[("t_s", t.clone())], &[("k", 1.0)]).unwrap_err();
-        assert_eq!(e.span, 4..10);
         assert!(
-            e.msg.contains("the run has no column `temp_c`"),
+            e.msg.contains(&f("divides by zero (at {t} = 2)")),
             "{}",
             e.msg
         );
-        let e = run("k * rate_dps", &[("t_s", t.clone())], &[("k", 1.0)]).unwrap_err();
+        let e = run("k * {T}", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
+        assert_eq!(e.span, 4..10);
+        assert!(
+            e.msg.contains(&f("the run has no column `{T}`")),
+            "{}",
+            e.msg
+        );
+        let e = run("k * {y}", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
         assert!(e.msg.contains("the gyro's output"), "{}", e.msg);
-        let e = run("exp(1000 * t_s)", &[("t_s", t.clone())], &[]).unwrap_err();
-        assert!(e.msg.contains("exp overflows (at t_s = 1)"), "{}", e.msg);
-        let e = run("(t_s - 3)^0.5", &[("t_s", t)], &[]).unwrap_err();
-        assert!(e.msg.contains("not finite (at t_s = 0)"), "{}", e.msg);
+        let e = run("exp(1000 * {t})", &[(Column::Time, t.clone())], &[]).unwrap_err();
+        assert!(
+            e.msg.contains(&f("exp overflows (at {t} = 1)")),
+            "{}",
+            e.msg
+        );
+        let e = run("({t} - 3)^0.5", &[(Column::Time, t)], &[]).unwrap_err();
+        assert!(e.msg.contains(&f("not finite (at {t} = 0)")), "{}", e.msg);
     }
 }
