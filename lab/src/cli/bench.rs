@@ -253,6 +253,7 @@ fn print_families(j: &ScaleFactorBench) {
 
 #[derive(Args, Debug, Clone)]
 pub struct AllanBenchArgs {
+    /// Records per noise-term combination (each its own seed).
     #[arg(long, default_value_t = 100)]
     pub seeds: u64,
     /// The first seed (seeds first..first + seeds): another set of seeds

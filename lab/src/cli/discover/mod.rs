@@ -66,6 +66,7 @@ impl From<GradeArg> for Grade {
 
 #[derive(Args, Debug, Clone)]
 pub struct DiscoverArgs {
+    /// The gyro the run is from: its kind sets the ideal model and the library of effects.
     #[arg(long, value_enum)]
     pub gyro: GyroArg,
     /// The gyro's grade: sets the physical ranges of the effects'
