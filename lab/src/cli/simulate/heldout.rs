@@ -26,6 +26,8 @@ pub enum Generator {
 
 #[derive(Args, Debug, Clone)]
 pub struct HeldOutArgs {
+    /// Which independent generator writes the set: `second` (issue 22's
+    /// 53 runs) or `third` (issue 31's, written apart from both).
     #[arg(long, value_enum, default_value = "second")]
     pub generator: Generator,
     #[command(flatten)]
