@@ -161,6 +161,13 @@ pub struct HeldOutBenchArgs {
     pub json: Json,
 }
 
+/// A run's index in the set, its score and whether its second day was
+/// predicted (None: it has none).
+type Indexed = (
+    usize,
+    Result<(crate::bench::discover_heldout::Scored, Option<bool>), LabError>,
+);
+
 pub fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
     use crate::bench::discover_heldout::{score, totals, Scored, Truth};
     use crate::model::discovery::{discover as run_discover, Options};
@@ -216,31 +223,29 @@ pub fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
         Ok((score(t, &r), validated))
     };
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<Vec<(usize, Result<(Scored, Option<bool>), LabError>)>> =
-        std::thread::scope(|sc| {
-            let workers: Vec<_> = (0..2)
-                .map(|_| {
-                    sc.spawn(|| {
-                        let mut out = vec![];
-                        loop {
-                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                            let Some(t) = truth.get(i) else {
-                                break;
-                            };
-                            out.push((i, one(t)));
-                            bar.inc(1);
-                        }
-                        out
-                    })
+    let results: Vec<Vec<Indexed>> = std::thread::scope(|sc| {
+        let workers: Vec<_> = (0..2)
+            .map(|_| {
+                sc.spawn(|| {
+                    let mut out = vec![];
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(t) = truth.get(i) else {
+                            break;
+                        };
+                        out.push((i, one(t)));
+                        bar.inc(1);
+                    }
+                    out
                 })
-                .collect();
-            workers
-                .into_iter()
-                .map(|w| w.join().unwrap_or_default())
-                .collect()
-        });
-    let mut all: Vec<(usize, Result<(Scored, Option<bool>), LabError>)> =
-        results.into_iter().flatten().collect();
+            })
+            .collect();
+        workers
+            .into_iter()
+            .map(|w| w.join().unwrap_or_default())
+            .collect()
+    });
+    let mut all: Vec<Indexed> = results.into_iter().flatten().collect();
     all.sort_by_key(|x| x.0);
     let mut scored = vec![];
     let mut second_days: Vec<(String, bool)> = vec![];

@@ -119,6 +119,9 @@ fn rms_1s(t: &[f64], x: &[f64], about_mean: bool) -> f64 {
     (m.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / m.len().max(1) as f64).sqrt() * 3600.0
 }
 
+/// Extra noise a null run adds on top of the gyro's own.
+type ExtraNoise = Box<dyn Fn(&mut NoiseSpec, &mut Rng)>;
+
 /// What a run is made of.
 struct Spec {
     name: String,
@@ -127,7 +130,7 @@ struct Spec {
     truth: Truth,
     expect: Vec<&'static str>,
     /// Extra noise (nulls) on top of the gyro's own.
-    extra: Option<Box<dyn Fn(&mut NoiseSpec, &mut Rng)>>,
+    extra: Option<ExtraNoise>,
     /// Scale the truth so that the 1 s means of what it adds have an RMS
     /// (about their mean for the terms outside the library, whose level
     /// the constant takes) of this many white floors.
@@ -184,7 +187,7 @@ fn make(s: &Spec, seed: u64) -> ThirdRun {
     let day2 = (g == GyroKind::Mems).then(|| {
         // The same gyro another day: its coefficients, another turn-on
         // bias and another temperature history; its own noise draw.
-        let mut r2 = Rng::new(seed ^ 0xDA7_2);
+        let mut r2 = Rng::new(seed ^ 0xDA72);
         let (ph2, dt2) = s.profile.build(&mut r2);
         let mut t2 = truth.clone();
         t2.bias_dph += r2.signed(20.0, 200.0);
@@ -583,7 +586,7 @@ pub fn third_set(seed: u64) -> Vec<ThirdRun> {
             "sine-fog",
             FogSoak,
             Truth {
-                sine: Some((1.0, 0.0, r.between(0.0, 6.28))),
+                sine: Some((1.0, 0.0, r.between(0.0, std::f64::consts::TAU))),
                 ..d()
             },
         ),
@@ -591,7 +594,7 @@ pub fn third_set(seed: u64) -> Vec<ThirdRun> {
             "sine-rlg",
             RlgChamber,
             Truth {
-                sine: Some((1.0, 0.0, r.between(0.0, 6.28))),
+                sine: Some((1.0, 0.0, r.between(0.0, std::f64::consts::TAU))),
                 ..d()
             },
         ),
