@@ -75,12 +75,22 @@ fn allan_section(r: &mut Report, d: &Discovery) {
         // term, the random walk's K^2 tau/3. (The Allan terms of the
         // residual before the model read a missing effect as noise.)
         let m = d.noise.capped(d.grade.value.noise_caps());
+        // A window's white variance is that of one sample where the record
+        // is sparser than the windows (a row every 15 s): white N^2/tau
+        // from the windows' own spacing.
+        let mut gaps: Vec<f64> = d.windows.t.windows(2).map(|p| p[1] - p[0]).collect();
+        gaps.sort_by(f64::total_cmp);
+        let dt = gaps
+            .get(gaps.len() / 2)
+            .copied()
+            .unwrap_or(WINDOW_S)
+            .max(WINDOW_S);
         let model: Vec<(f64, f64)> = a
             .taus
             .iter()
-            .filter(|&&t| t >= WINDOW_S)
+            .filter(|&&t| t >= dt)
             .map(|&t| {
-                let v = m.white * WINDOW_S / t
+                let v = m.white * dt / t
                     + m.flicker * terms::basis(2, t)
                     + m.markov * markov_avar(t, m.markov_s.max(1e-9))
                     + m.random_walk * t / 3.0;
