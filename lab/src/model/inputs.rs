@@ -2,7 +2,9 @@
 //! reference rate, the temperatures the run has, and the angular
 //! acceleration.
 
+use crate::data::run_file::Column;
 use crate::numerics::thermal_difference::dt_and_gradient;
+use std::collections::BTreeMap;
 
 /// Least half width of the monoblock difference's slope, s: its lags are
 /// thousands of seconds.
@@ -105,6 +107,8 @@ pub struct Inputs {
     pub grad: Option<Vec<f64>>,
     /// The monoblocks' mean, degC.
     pub mono_mean: Option<Vec<f64>>,
+    /// The two monoblock sensors as read, degC (for terms that name them).
+    pub mono: Option<(Vec<f64>, Vec<f64>)>,
     /// Case sensor, degC.
     pub case: Option<Vec<f64>>,
     /// Angular acceleration, deg/s^2, and whether it was derived from the
@@ -126,10 +130,10 @@ impl Inputs {
         let mono_mean = mono
             .as_ref()
             .map(|(a, b)| a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect());
-        let (dt, grad) = match mono {
+        let (dt, grad) = match &mono {
             Some((a, b)) => {
-                let (d, _) = dt_and_gradient(&t, &a, &b);
-                let h = gradient_half_width(&t, &d, resolution(&a).max(resolution(&b)));
+                let (d, _) = dt_and_gradient(&t, a, b);
+                let h = gradient_half_width(&t, &d, resolution(a).max(resolution(b)));
                 let g = centered_slope(&t, &d, h);
                 (Some(d), Some(g))
             }
@@ -161,10 +165,33 @@ impl Inputs {
             dt,
             grad,
             mono_mean,
+            mono,
             case,
             acc,
             acc_derived,
         }
+    }
+
+    /// The run's input columns present, by their run-file names (what a
+    /// term's formula reads; the acceleration only where the run has it).
+    pub fn columns(&self) -> BTreeMap<&'static str, &[f64]> {
+        let mut c = BTreeMap::new();
+        c.insert(Column::Time.name(), self.t.as_slice());
+        c.insert(Column::RefRate.name(), self.w.as_slice());
+        if let Some(x) = &self.temp {
+            c.insert(Column::Temp.name(), x.as_slice());
+        }
+        if let Some((a, b)) = &self.mono {
+            c.insert(Column::MonoA.name(), a.as_slice());
+            c.insert(Column::MonoB.name(), b.as_slice());
+        }
+        if let Some(x) = &self.case {
+            c.insert(Column::Case.name(), x.as_slice());
+        }
+        if !self.acc_derived {
+            c.insert(Column::RefAcc.name(), self.acc.as_slice());
+        }
+        c
     }
 
     pub fn len(&self) -> usize {

@@ -12,5 +12,6 @@ pub mod grade;
 pub mod gyro_kind;
 pub mod gyro_model;
 pub mod inputs;
+pub mod proposal;
 pub mod ranges;
 pub mod term;
