@@ -94,11 +94,11 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
-    /// The host's (the brute-force check holds it to 1e-4 of a crossing's error).
+    /// The host's (against the brute force: 2e-4 of a crossing's error).
     pub const HOST: Accuracy = Accuracy {
         c1: 7.0,
         c2: 50.0,
-        step_rad: 0.5,
+        step_rad: 0.8,
     };
     /// Cheaper, for the firmware under QEMU (f32 inside the windows).
     pub const QEMU: Accuracy = Accuracy {
@@ -217,7 +217,11 @@ impl Half {
     }
     /// Dither angle at time t (within or at the ends of the half), deg.
     pub fn theta_at(&self, t: f64) -> f64 {
-        self.theta(((t - self.t0) / self.h).clamp(0.0, 1.0))
+        self.theta_x(t - self.t0)
+    }
+    /// Dither angle at time x since the half's start, deg.
+    pub fn theta_x(&self, x: f64) -> f64 {
+        self.theta((x / self.h).clamp(0.0, 1.0))
     }
     /// Pickoff zero crossing (the angle's), s.
     pub fn zero_crossing(&self) -> f64 {
@@ -346,7 +350,9 @@ const TAYLOR: usize = 10;
 
 
 /// The dithered RLG; `F` is the float of the inner loops (f64 on the host,
-/// f32 under QEMU), the bookkeeping is f64.
+/// f32 under QEMU), the bookkeeping is f64. Time is kept as the current
+/// half cycle's start and the time since it (`x`): at hundreds of seconds
+/// a global time's rounding would be a thousand times a window's fine edge.
 pub struct DitheredRlg<F = f64> {
     pub p: DitherParams,
     k_fr: f64,
@@ -358,7 +364,8 @@ pub struct DitheredRlg<F = f64> {
     latch_done: bool,
     /// Fine intervals of `cur` for the rate they were found at.
     windows: Windows,
-    t: f64,
+    /// Time since `cur.t0`, s.
+    x: f64,
     /// K_fr times the input angle, fringes, at `t_anchor`, and its rate
     /// (fringes/s) over the present `advance`; the initial fringe fraction.
     psi_anchor: f64,
@@ -391,17 +398,18 @@ impl<F: Float> DitheredRlg<F> {
         let od = p.omega_dot() * (1.0 + 4.0 * p.noise_frac) * (1.0 + p.fd_drift_frac).powi(2);
         let w_rate = (p.accuracy.c1 * (od / (2.0 * PI * k_fr)).sqrt())
             .max(p.accuracy.c2 * p.lock_in_dps);
+        let cur = motion.current();
         Self {
             p,
             k_fr,
             kappa: k_fr * p.lock_in_dps,
             w_rate,
             w_fresnel: (2.0 * PI * k_fr * od).sqrt(),
-            cur: motion.current(),
+            x: -cur.t0,
+            cur,
             motion,
             latch_done: false,
             windows: Windows::default(),
-            t: 0.0,
             psi_anchor: 0.0,
             t_anchor: 0.0,
             kr: 0.0,
@@ -416,7 +424,7 @@ impl<F: Float> DitheredRlg<F> {
 
     /// Time, s.
     pub fn time(&self) -> f64 {
-        self.t
+        self.cur.t0 + self.x
     }
 
     /// Window half-width in rate, deg/s.
@@ -432,63 +440,64 @@ impl<F: Float> DitheredRlg<F> {
         rate_dps: f64,
         mut on_latch: impl FnMut(&Latch),
     ) -> Reading {
-        self.psi_anchor = self.psi(self.t);
-        self.t_anchor = self.t;
+        self.psi_anchor = self.psi(self.x);
+        self.t_anchor = self.time();
         self.kr = self.k_fr * rate_dps;
-        while self.t < t_end {
-            if self.t >= self.cur.end() {
+        loop {
+            if self.x >= self.cur.h {
+                self.x -= self.cur.h;
                 self.cur = self.motion.next_half();
                 self.latch_done = false;
                 self.windows.valid = false;
             }
             let hc = self.cur;
+            // Local times: rounding stays at the half cycle's scale.
+            let x_end = t_end - hc.t0;
+            if self.x >= x_end {
+                break;
+            }
             if !self.windows.valid || self.windows.rate != rate_dps {
                 self.windows = find_windows(&hc, rate_dps, self.w_rate, self.p.lock_in_dps > 0.0);
             }
-            // Nudged: a boundary just reached (rounding) counts as passed.
-            let s = (self.t - hc.t0) / hc.h + 1e-12;
-            let (in_fine, s_next) = self.windows.at(s);
-            let latch_t = hc.zero_crossing() + self.p.pickoff_delay_s;
-            let mut t_seg = (hc.t0 + s_next * hc.h).min(hc.end()).min(t_end);
-            if t_seg <= self.t {
-                t_seg = hc.end().min(t_end);
+            // Nudged by 1e-9 of a half cycle (1e-12 s): a boundary reached
+            // up to rounding counts as passed, so every segment moves on.
+            let (in_fine, s_next) = self.windows.at(self.x / hc.h + 1e-9);
+            let x_latch = 0.5 * hc.h + self.p.pickoff_delay_s;
+            let mut x_seg = (s_next * hc.h).min(hc.h).min(x_end);
+            if !self.latch_done && x_latch > self.x {
+                x_seg = x_seg.min(x_latch);
             }
-            if !self.latch_done && latch_t > self.t {
-                t_seg = t_seg.min(latch_t);
-            }
-            if t_seg <= self.t {
-                // Rounding at the half cycle's end: move on to the next.
-                self.t = hc.end().max(self.t);
-                if t_end <= self.t {
-                    break;
-                }
+            if x_seg <= self.x {
+                // Only at the half cycle's end (rounding): roll over.
+                self.x = hc.h;
                 continue;
             }
             if in_fine {
                 if !self.fine {
-                    self.e = self.to_actual(&hc, self.t, rate_dps, self.e);
+                    self.e = self.to_actual(&hc, self.x, rate_dps, self.e);
                     self.fine = true;
                 }
-                self.fine_to(&hc, t_seg, rate_dps);
+                self.fine_to(&hc, x_seg, rate_dps);
             } else {
                 if self.fine {
-                    self.e = self.to_mean(&hc, self.t, rate_dps, self.e);
+                    self.e = self.to_mean(&hc, self.x, rate_dps, self.e);
                     self.fine = false;
                 }
-                self.e += self.outer_drift(&hc, self.t, t_seg, rate_dps);
+                self.e += self.outer_drift(&hc, self.x, x_seg, rate_dps);
             }
-            self.t = t_seg;
-            if !self.latch_done && self.t >= latch_t {
+            self.x = x_seg;
+            if !self.latch_done && self.x >= x_latch {
                 self.latch_done = true;
                 let l = self.latch(&hc, rate_dps);
                 on_latch(&l);
             }
         }
-        self.t = t_end;
         let hc = self.cur;
-        let psi = self.psi(t_end);
-        let e = self.actual_error(&hc, t_end, rate_dps);
-        let dither = self.k_fr * hc.theta_at(t_end);
+        // The reading at t_end exactly (x may differ from it by rounding).
+        let x = t_end - hc.t0;
+        let psi = self.psi(x);
+        let e = self.actual_error(&hc, x, rate_dps);
+        let dither = self.k_fr * hc.theta_x(x);
         let fr = self.f0 + psi + dither + e;
         let counts = (4.0 * fr).floor() as i64;
         Reading {
@@ -501,30 +510,31 @@ impl<F: Float> DitheredRlg<F> {
         }
     }
 
-    /// K_fr times the input angle at t (within the present `advance`), fringes.
-    fn psi(&self, t: f64) -> f64 {
-        self.psi_anchor + self.kr * (t - self.t_anchor)
+    /// K_fr times the input angle at local time x (within the present
+    /// `advance`), fringes.
+    fn psi(&self, x: f64) -> f64 {
+        self.psi_anchor + self.kr * ((self.cur.t0 - self.t_anchor) + x)
     }
 
-    /// The actual error at t (adds the ripple outside the windows).
-    fn actual_error(&self, hc: &Half, t: f64, rate: f64) -> f64 {
+    /// The actual error at x (adds the ripple outside the windows).
+    fn actual_error(&self, hc: &Half, x: f64, rate: f64) -> f64 {
         if self.fine {
             self.e
         } else {
-            self.to_actual(hc, t, rate, self.e)
+            self.to_actual(hc, x, rate, self.e)
         }
     }
 
-    /// Total fringes at t for an error e.
-    fn fringes(&self, hc: &Half, t: f64, e: f64) -> f64 {
-        self.f0 + self.psi(t) + self.k_fr * hc.theta_at(t) + e
+    /// Total fringes at local time x for an error e.
+    fn fringes(&self, hc: &Half, x: f64, e: f64) -> f64 {
+        self.f0 + self.psi(x) + self.k_fr * hc.theta_x(x) + e
     }
 
-    /// The near-identity transform's coefficients at t: `u = v + r1 cos v
+    /// The near-identity transform's coefficients at x: `u = v + r1 cos v
     /// + r2 sin v`, `r1 = a/w`, `r2 = a w'/w^3` (the second removes the
     /// `a w'/w^2` term from the averaged equation).
-    fn ripple(&self, hc: &Half, t: f64, rate: f64) -> (f64, f64) {
-        let s = ((t - hc.t0) / hc.h).clamp(0.0, 1.0);
+    fn ripple(&self, hc: &Half, x: f64, rate: f64) -> (f64, f64) {
+        let s = (x / hc.h).clamp(0.0, 1.0);
         let om = rate + hc.rate(s);
         let r1 = self.p.lock_in_dps / om;
         let r2 = r1 * hc.accel(s) / (2.0 * PI * self.k_fr * om * om);
@@ -532,23 +542,30 @@ impl<F: Float> DitheredRlg<F> {
     }
 
     /// Mean error -> actual.
-    fn to_actual(&self, hc: &Half, t: f64, rate: f64, e_mean: f64) -> f64 {
+    fn to_actual(&self, hc: &Half, x: f64, rate: f64, e_mean: f64) -> f64 {
         if self.kappa == 0.0 {
             return e_mean;
         }
-        let (r1, r2) = self.ripple(hc, t, rate);
-        let v = 2.0 * PI * frac(self.fringes(hc, t, e_mean)) + self.p.beta_rad;
+        let (r1, r2) = self.ripple(hc, x, rate);
+        if !(r1.abs() < 1.0 && r2.abs() < 1.0) {
+            // Not where the transform holds (never at a window's edge).
+            return e_mean;
+        }
+        let v = 2.0 * PI * frac(self.fringes(hc, x, e_mean)) + self.p.beta_rad;
         let (sv, cv) = v.sin_cos();
         e_mean + (r1 * cv + r2 * sv) / (2.0 * PI)
     }
 
     /// Actual error -> mean: solves `v = u - r1 cos v - r2 sin v` by iteration.
-    fn to_mean(&self, hc: &Half, t: f64, rate: f64, e: f64) -> f64 {
+    fn to_mean(&self, hc: &Half, x: f64, rate: f64, e: f64) -> f64 {
         if self.kappa == 0.0 {
             return e;
         }
-        let (r1, r2) = self.ripple(hc, t, rate);
-        let u = 2.0 * PI * frac(self.fringes(hc, t, e)) + self.p.beta_rad;
+        let (r1, r2) = self.ripple(hc, x, rate);
+        if !(r1.abs() < 1.0 && r2.abs() < 1.0) {
+            return e;
+        }
+        let u = 2.0 * PI * frac(self.fringes(hc, x, e)) + self.p.beta_rad;
         let mut v = u;
         for _ in 0..4 {
             let (sv, cv) = v.sin_cos();
@@ -558,18 +575,19 @@ impl<F: Float> DitheredRlg<F> {
         e - (r1 * cv + r2 * sv) / (2.0 * PI)
     }
 
-    /// Drift of the mean error over [ta, tb] outside the windows:
-    /// `-K_fr Omega_L^2/2 * integral dt/Omega_I` (two 8-node panels).
-    fn outer_drift(&self, hc: &Half, ta: f64, tb: f64, rate: f64) -> f64 {
-        if self.kappa == 0.0 || tb <= ta {
+    /// Drift of the mean error over local times [xa, xb] outside the
+    /// windows: `-K_fr Omega_L^2/2 * integral dt/Omega_I` (two 8-node
+    /// Gauss-Legendre panels).
+    fn outer_drift(&self, hc: &Half, xa: f64, xb: f64, rate: f64) -> f64 {
+        if self.kappa == 0.0 || xb <= xa {
             return 0.0;
         }
         let c = |x: f64| F::from(x).unwrap_or(F::zero());
-        let (h, t0) = (c(hc.h), c(hc.t0 - ta));
+        let (h, x0) = (c(hc.h), c(xa));
         let (abar, d, sign, om) = (c(hc.abar()), c(hc.d()), c(hc.sign), c(rate));
         let pi = c(PI);
-        let inv = |dt: F| {
-            let s = (dt - t0) / h;
+        let inv = |dx: F| {
+            let s = (x0 + dx) / h;
             let (sn, cs) = (pi * s).sin_cos();
             let oi = om + sign * pi / h * sn * (abar - d * cs);
             if oi.abs() > F::epsilon() {
@@ -578,34 +596,32 @@ impl<F: Float> DitheredRlg<F> {
                 F::zero()
             }
         };
-        let half = 0.25 * (tb - ta);
+        let half = 0.25 * (xb - xa);
         let mut sum = F::zero();
         for panel in 0..2 {
             let mid = (2 * panel + 1) as f64 * half;
             for k in 0..4 {
                 let w = c(GL_W[k]);
-                sum = sum
-                    + w * (inv(c(mid + half * GL_X[k])) + inv(c(mid - half * GL_X[k])));
+                sum = sum + w * (inv(c(mid + half * GL_X[k])) + inv(c(mid - half * GL_X[k])));
             }
         }
         let integral = sum.to_f64().unwrap_or(0.0) * half;
         -0.5 * self.k_fr * self.p.lock_in_dps * self.p.lock_in_dps * integral
     }
 
-    /// RK4 of E from the current time to `tb` (inside one half cycle), in
-    /// pieces of at most MAX_PIECE.
-    fn fine_to(&mut self, hc: &Half, tb: f64, rate: f64) {
-        let s_end = (tb - hc.t0) / hc.h;
-        while self.t < tb {
-            let sa = (self.t - hc.t0) / hc.h;
-            let t_b = if s_end - sa > MAX_PIECE {
-                hc.t0 + (sa + MAX_PIECE) * hc.h
+    /// RK4 of E from the current local time to `xb` (inside one half
+    /// cycle), in pieces of at most MAX_PIECE.
+    fn fine_to(&mut self, hc: &Half, xb: f64, rate: f64) {
+        let x_max = MAX_PIECE * hc.h;
+        while self.x < xb {
+            let x_b = if xb - self.x > x_max {
+                self.x + x_max
             } else {
-                tb
+                xb
             };
-            let f_ref = frac(self.fringes(hc, self.t, self.e));
-            self.e += self.piece(hc, sa, t_b - self.t, f_ref, rate);
-            self.t = t_b;
+            let f_ref = frac(self.fringes(hc, self.x, self.e));
+            self.e += self.piece(hc, self.x / hc.h, x_b - self.x, f_ref, rate);
+            self.x = x_b;
         }
     }
 
@@ -660,7 +676,7 @@ impl<F: Float> DitheredRlg<F> {
             // Fringes relative to an integer: the phase stays small.
             let z = f_ref + kr * x + poly(&cf, x * inv_h) + e;
             let z = z - z.round();
-            -kappa * (two_pi * z + beta).sin()
+            -kappa * sin_small(two_pi * z + beta)
         };
         let wf = c(self.w_fresnel + 2.0 * PI * self.kappa);
         let step = c(self.p.accuracy.step_rad);
@@ -687,24 +703,24 @@ impl<F: Float> DitheredRlg<F> {
 
     /// The latch at the current time (the zero crossing plus the pickoff's delay).
     fn latch(&mut self, hc: &Half, rate: f64) -> Latch {
-        let t = self.t;
-        let psi = self.psi(t);
-        let e = self.actual_error(hc, t, rate);
-        let fr = self.fringes(hc, t, e);
+        let x = self.x;
+        let psi = self.psi(x);
+        let e = self.actual_error(hc, x, rate);
+        let fr = self.fringes(hc, x, e);
         let counts = (4.0 * fr).floor() as i64;
         // The photodiodes a little later: the dither and input angle move
         // on (exactly), the lock-in error by its rate.
-        let ta = t + self.p.adc_delay_s;
+        let xa = x + self.p.adc_delay_s;
         let de = -self.kappa
             * (2.0 * PI * frac(fr) + self.p.beta_rad).sin()
             * self.p.adc_delay_s;
         let fr_adc = self.f0
             + psi
-            + self.k_fr * (rate * self.p.adc_delay_s + hc.theta_at(ta))
+            + self.k_fr * (rate * self.p.adc_delay_s + hc.theta_x(xa))
             + e
             + de;
         Latch {
-            t_s: t,
+            t_s: hc.t0 + x,
             counter: counts as u16,
             counts,
             rising: hc.sign > 0.0,
@@ -737,7 +753,9 @@ impl Windows {
     fn at(&self, s: f64) -> (bool, f64) {
         let mut next = 1.0;
         for &(a, b) in &self.iv[..self.n] {
-            if s >= a && s < b {
+            // An interval that ends at the turnaround holds to it (s may
+            // pass 1 by rounding there).
+            if s >= a && (s < b || b >= 1.0) {
                 return (true, b);
             }
             if a > s {
@@ -814,6 +832,39 @@ fn solve(hc: &Half, level: f64, a: f64, b: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// sin for |x| below a few pi (the inner loop's reduced phase): quadrant
+/// reduction and the Taylor series on [-pi/4, pi/4] (error below 1e-15;
+/// libm's general argument reduction took most of the simulator's time).
+fn sin_small<F: Float>(x: F) -> F {
+    let c = |v: f64| F::from(v).unwrap_or(F::zero());
+    let q = (x * c(2.0 / PI)).round();
+    let r = x - q * c(PI / 2.0);
+    let r2 = r * r;
+    let sin = || {
+        r * (F::one()
+            + r2 * (c(-1.0 / 6.0)
+                + r2 * (c(1.0 / 120.0)
+                    + r2 * (c(-1.0 / 5040.0)
+                        + r2 * (c(1.0 / 362_880.0)
+                            + r2 * (c(-1.0 / 39_916_800.0) + r2 * c(1.0 / 6_227_020_800.0)))))))
+    };
+    let cos = || {
+        F::one()
+            + r2 * (c(-0.5)
+                + r2 * (c(1.0 / 24.0)
+                    + r2 * (c(-1.0 / 720.0)
+                        + r2 * (c(1.0 / 40_320.0)
+                            + r2 * (c(-1.0 / 3_628_800.0)
+                                + r2 * (c(1.0 / 479_001_600.0) + r2 * c(-1.0 / 87_178_291_200.0)))))))
+    };
+    match q.to_i64().unwrap_or(0).rem_euclid(4) {
+        0 => sin(),
+        1 => cos(),
+        2 => -sin(),
+        _ => -cos(),
+    }
 }
 
 fn frac(x: f64) -> f64 {
