@@ -18,6 +18,10 @@ use super::counter::PulseCounter;
 use super::dither::{DitherStripper, LatchSample, StripConfig, StripFlags};
 use super::thermal::{RlgFlags, Temperatures, ThermalComp, ThermalConfig};
 
+/// Updates a dithered channel waits at start for its first stripped angle
+/// before it outputs the raw count, flagged (50 ms: a dead pickoff).
+const START_WAIT: u32 = 25;
+
 /// ndps per (deg/h), Q16: 1e9/3600 * 2^16.
 const NDPS_PER_DPH_Q16: i64 = 18_204_444_444;
 
@@ -111,8 +115,10 @@ pub struct RlgChannel {
     out_q16: i64,
     taken_q16: i64,
     started: bool,
-    /// The stripping has given an angle (after that, none is a fault).
+    /// The stripping has given an angle (after that, none is a fault), and
+    /// the updates waited for it at start.
     stripping: bool,
+    waited: u32,
     frame_updates: u32,
 }
 
@@ -142,19 +148,21 @@ impl RlgChannel {
         let out = match &cfg.dither {
             None => Some(raw_q16),
             Some(_) => {
-                let out = self.prev.map(|(t, raw_prev)| match self.strip.at(t) {
+                let out = self.prev.and_then(|(t, raw_prev)| match self.strip.at(t) {
                     Some(v) => {
                         self.stripping = true;
-                        v
+                        Some(v)
+                    }
+                    None if self.stripping || self.waited >= START_WAIT => {
+                        // Safe path: the raw count (with its dither), flagged.
+                        self.strip.flag(StripFlags::NO_PICKOFF);
+                        Some(raw_prev)
                     }
                     None => {
-                        // Safe path: the raw count (with its dither),
-                        // flagged once the stripping has run (at start the
-                        // first latches come before the first read).
-                        if self.stripping {
-                            self.strip.flag(StripFlags::NO_PICKOFF);
-                        }
-                        raw_prev
+                        // Start-up: the frames start from the first stripped
+                        // angle (a raw one carries the dither as an offset).
+                        self.waited += 1;
+                        None
                     }
                 });
                 self.prev = Some((time, raw_q16));

@@ -215,7 +215,9 @@ impl DitherStripper {
         if self.len > 0 {
             let last = self.newest();
             let dt = l.time.wrapping_sub(last.time);
-            if l.rising == last.rising || dt < cfg.min_half {
+            // Not after the newest (a wrapping difference of 2^31 or more),
+            // the same polarity twice, or too soon: a glitch.
+            if l.rising == last.rising || dt < cfg.min_half || dt >= 1 << 31 {
                 self.flags |= StripFlags::LATCH_REFUSED;
                 return;
             }
@@ -256,12 +258,20 @@ impl DitherStripper {
         if self.pd_seen < LEARN {
             // The counter's quadrant against the phase's: a whole number of
             // counts (the counter started anywhere), the mean of N + 1/2 - c
-            // rounded. At rest the count's fraction is not uniform, so the
-            // mean is off by up to half a count: only the rounding is used.
-            self.offset_sum = self.offset_sum.wrapping_add(wrap_fringe(middle - c));
+            // rounded. Each is taken against the first (a circular mean:
+            // they spread by under a count, the wrap is at two). At rest the
+            // count's fraction is not uniform, so the mean is off by up to
+            // half a count: only its rounding is used.
+            if self.pd_seen == 0 {
+                self.offset_q16 = wrap_fringe(middle - c);
+                self.offset_sum = 0;
+            }
+            self.offset_sum = self
+                .offset_sum
+                .wrapping_add(wrap_fringe(middle - c - self.offset_q16));
             self.pd_seen += 1;
             if self.pd_seen == LEARN {
-                let mean = self.offset_sum / LEARN as i64;
+                let mean = self.offset_q16 + self.offset_sum / LEARN as i64;
                 self.offset_q16 = ((mean + Q16 / 2) >> 16).rem_euclid(4) << 16;
             }
             return middle;
@@ -332,11 +342,6 @@ impl DitherStripper {
 
     fn corrected(&self, s: &Stored) -> i64 {
         s.angle_q16 - sign(s.rising) * self.alt_q16
-    }
-
-    #[doc(hidden)]
-    pub fn debug_newest(&self) -> i64 {
-        self.newest().angle_q16
     }
 
     /// The alternation learnt (angle lead at a rising latch), Q16 counts.

@@ -16,6 +16,11 @@ use gyro_sp::rlg::{LatchSample, RlgChannel, RlgConfig, StripConfig, ThermalCoeff
 pub const FRAME_HZ: u32 = 500;
 /// The latch timer's clock on the hw board (TIM5 at 84 MHz), Hz.
 pub const CLOCK_HZ: u32 = 84_000_000;
+/// Frames averaged for the Allan analysis (its tau0 = 20 ms): below that
+/// the curve holds the stripping's residual and the frames' aliasing of it
+/// (hundredths of a count, white in angle), which at the low random walks
+/// of the range hide the walk's slope from the fit.
+pub const ALLAN_FRAMES: usize = 10;
 
 /// One run's settings.
 #[derive(Clone, Copy, Debug)]
@@ -58,8 +63,14 @@ pub struct DitherSummary {
     pub arw_dpsh: Option<f64>,
     pub arw_lo_dpsh: Option<f64>,
     pub arw_hi_dpsh: Option<f64>,
-    /// The crossing map's long-time random walk, deg/sqrt(h).
+    /// The crossings' random walk the physics predicts, deg/sqrt(h)
+    /// (Killpatrick's with the kicks' random part, `sqrt(1 - e^(-sigma^2))`).
     pub arw_predicted_dpsh: f64,
+    /// The long-time walk where a dynamic lock-in zone holds the phase
+    /// (the washboard's effective diffusion), deg/sqrt(h), and the zone's
+    /// relaxation time, s (null: no pull).
+    pub arw_long_time_predicted_dpsh: f64,
+    pub zone_relaxation_s: Option<f64>,
     /// Killpatrick's `Omega_L/sqrt(2 pi K Omega_d)`, K in fringes per degree.
     pub arw_killpatrick_dpsh: f64,
     /// The same formula with K in counts per degree (4x the fringes): what
@@ -224,7 +235,12 @@ impl DitherRun {
         }
         progress(n);
         let wall_s = wall.elapsed().as_secs_f64();
-        let a = analyse(&rates, dt).map_err(|e| DitherRunError::Analysis(e.to_string()))?;
+        let averaged: Vec<f64> = rates
+            .chunks_exact(ALLAN_FRAMES)
+            .map(|c| c.iter().sum::<f64>() / ALLAN_FRAMES as f64)
+            .collect();
+        let a = analyse(&averaged, dt * ALLAN_FRAMES as f64)
+            .map_err(|e| DitherRunError::Analysis(e.to_string()))?;
         const ARW: usize = 1;
         let t = &a.terms;
         let term = |v: f64| t.present[ARW].then(|| to_units(ARW, v));
@@ -245,6 +261,8 @@ impl DitherRun {
             arw_lo_dpsh: term(t.lo[ARW]),
             arw_hi_dpsh: term(t.hi[ARW]),
             arw_predicted_dpsh: dpsh(pred.arw_dps_rts),
+            arw_long_time_predicted_dpsh: dpsh(pred.arw_long_dps_rts),
+            zone_relaxation_s: pred.relaxation_s.is_finite().then_some(pred.relaxation_s),
             arw_killpatrick_dpsh: dpsh(pred.killpatrick_dps_rts),
             arw_killpatrick_counts_k_dpsh: dpsh(killpatrick_counts),
             dither_residual_counts_rms: res_rms,

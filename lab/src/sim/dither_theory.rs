@@ -33,12 +33,21 @@ use std::f64::consts::PI;
 /// The prediction for one set of parameters and input rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prediction {
-    /// Long-time angle random walk, deg/sqrt(s): the crossing map's.
+    /// The crossings' random walk, deg/sqrt(s): Killpatrick's times
+    /// `sqrt(1 - e^(-sigma^2))` (the kicks' random part). What the Allan
+    /// deviation shows at averaging times below the zone's relaxation time
+    /// (all of them where the zone does not hold the phase).
     pub arw_dps_rts: f64,
+    /// The long-time random walk (the washboard's effective diffusion),
+    /// deg/sqrt(s): below the former where a zone holds the phase.
+    pub arw_long_dps_rts: f64,
+    /// The zone's relaxation time `1/(a f)`, s (infinite without a pull).
+    pub relaxation_s: f64,
     /// Killpatrick's `Omega_L/sqrt(2 pi K Omega_d)` (K in fringes per
     /// degree), deg/sqrt(s).
     pub killpatrick_dps_rts: f64,
-    /// Mean rate error (the residual lock-in's pull), deg/s.
+    /// Mean rate error (the nearest zone's pull, exact, and the others'
+    /// tails), deg/s.
     pub rate_error_dps: f64,
     /// RMS of the fringe phase at a turnaround from the amplitude noise, rad.
     pub sigma_rad: f64,
@@ -75,11 +84,29 @@ pub fn predict(p: &DitherParams, rate_dps: f64) -> Prediction {
     let tilt = delta * f;
     let d = f * c * c * random / 2.0;
     let (v, d_eff) = washboard(a, tilt, d);
+    // The other zones pull too, each by its second-order tail (a noisy
+    // Adler far from lock: -(a^2/2) F/(F^2 + D^2)); summed in pairs
+    // either side, the sum converges.
+    let mut far = 0.0;
+    for j in 1..=64 {
+        for m in [zone - j as f64, zone + j as f64] {
+            let gm = if (m as i64).rem_euclid(2) == 0 {
+                y.cos().abs()
+            } else {
+                y.sin().abs()
+            };
+            let am = 2.0 * c * coherent * gm * f;
+            let fm = 2.0 * (nu - m * PI) * f;
+            far -= 0.5 * am * am * fm / (fm * fm + d * d);
+        }
+    }
     let to_deg = 1.0 / (2.0 * PI * k);
     Prediction {
-        arw_dps_rts: (2.0 * d_eff).max(0.0).sqrt() * to_deg,
+        arw_dps_rts: (2.0 * d).max(0.0).sqrt() * to_deg,
+        arw_long_dps_rts: (2.0 * d_eff).max(0.0).sqrt() * to_deg,
+        relaxation_s: if a > 0.0 { 1.0 / a } else { f64::INFINITY },
         killpatrick_dps_rts: p.killpatrick_arw_dps_rts(),
-        rate_error_dps: (v - tilt) * to_deg,
+        rate_error_dps: (v - tilt + far) * to_deg,
         sigma_rad: sigma,
         zone: zone as i64,
         residual_lock_in_dps: a * to_deg,
@@ -201,6 +228,7 @@ mod tests {
         let q = predict(&p, 0.0);
         assert!(q.sigma_rad > 10.0);
         assert!((q.arw_dps_rts / q.killpatrick_dps_rts - 1.0).abs() < 1e-9);
+        assert!((q.arw_long_dps_rts / q.killpatrick_dps_rts - 1.0).abs() < 1e-9);
         assert!(q.rate_error_dps.abs() < 1e-12);
     }
 }
