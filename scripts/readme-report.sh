@@ -2,7 +2,7 @@
 # Makes the README's report image (docs/report-scale-factor.png) from
 # scratch: a simulated continuous-rotation run of a coil with a knee at
 # 48 degC on a quadratic background (0.02 ppm/degC^2; 100 deg/s, chamber
-# -40..+60 degC, 0.01 deg/sqrt(h)), its scale-factor fit with report.html,
+# -40..+60 degC, 0.01 deg/sqrt(h)), its scale-factor fit with its report (fit/sf.html),
 # and the top of that report rendered by scripts/render-report.sh.
 #
 #   scripts/readme-report.sh [OUT.png]
@@ -23,4 +23,4 @@ cd "$work"
     --out knee-on-curve.csv >/dev/null
 mkdir -p fit
 "$lab" fit scale-factor --data knee-on-curve.csv --out fit/sf.toml >/dev/null
-"$root/scripts/render-report.sh" fit/report.html "$out" 1100 1450
+"$root/scripts/render-report.sh" fit/sf.html "$out" 1100 1450

@@ -8,6 +8,8 @@ pub use gyro_sp::frame::ResetCause;
 /// The word the HardFault handler leaves before it resets (RAM keeps it
 /// across a system reset, not across power loss).
 pub const HARD_FAULT_MARK: u32 = 0x4846_4C54; // "HFLT"
+/// The word the panic handler leaves before it resets.
+pub const PANIC_MARK: u32 = 0x5041_4E43; // "PANC"
 
 /// RCC_CSR's reset flags (RM0090 7.3.21), as bits of the register.
 pub mod csr {
@@ -34,10 +36,10 @@ pub const fn reset_cause(csr_bits: u32, mark: u32) -> ResetCause {
     } else if csr_bits & (csr::IWDGRSTF | csr::WWDGRSTF) != 0 {
         ResetCause::Watchdog
     } else if csr_bits & csr::SFTRSTF != 0 {
-        if mark == HARD_FAULT_MARK {
-            ResetCause::HardFault
-        } else {
-            ResetCause::Software
+        match mark {
+            HARD_FAULT_MARK => ResetCause::HardFault,
+            PANIC_MARK => ResetCause::Panic,
+            _ => ResetCause::Software,
         }
     } else if csr_bits & csr::PINRSTF != 0 {
         ResetCause::Pin
@@ -68,10 +70,16 @@ mod tests {
             reset_cause(SFTRSTF | PINRSTF, HARD_FAULT_MARK),
             ResetCause::HardFault
         );
+        assert_eq!(
+            reset_cause(SFTRSTF | PINRSTF, PANIC_MARK),
+            ResetCause::Panic
+        );
         assert_eq!(reset_cause(SFTRSTF | PINRSTF, 0x1234), ResetCause::Software);
+        assert_eq!(reset_cause(PORRSTF, PANIC_MARK), ResetCause::PowerOn);
         assert_eq!(reset_cause(PINRSTF, HARD_FAULT_MARK), ResetCause::Pin);
         assert_eq!(reset_cause(0, 0), ResetCause::None);
         assert!(ResetCause::HardFault.is_recovery() && ResetCause::Watchdog.is_recovery());
+        assert!(ResetCause::Panic.is_recovery());
         assert!(!ResetCause::PowerOn.is_recovery());
     }
 }

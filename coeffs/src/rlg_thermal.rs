@@ -42,6 +42,17 @@ impl ThermalCoeffs {
         tau_warm_s: 600.0,
     };
 
+    /// The values' names in record order (the file's keys).
+    pub const NAMES: [&'static str; 7] = [
+        "bias0_dph",
+        "k1_dph_per_c",
+        "k2_dph_per_c_per_s",
+        "k3_dph_per_c2",
+        "k4_dph_per_c",
+        "k5_dph",
+        "tau_warm_s",
+    ];
+
     /// The values in record order: bias0, k1..k5, tau_warm.
     pub fn values(&self) -> [f64; 7] {
         [

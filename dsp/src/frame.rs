@@ -65,13 +65,15 @@ pub enum ResetCause {
     PowerOn = 1,
     /// The reset pin (a debugger or the supervisor).
     Pin = 2,
-    /// The independent watchdog: the firmware stopped feeding it (a hang or
-    /// a panic, which waits for it).
+    /// The independent watchdog: the firmware stopped feeding it (a hang).
     Watchdog = 3,
     /// A HardFault: the handler logged it and reset.
     HardFault = 4,
     /// A software reset the firmware asked for (a refused configuration).
     Software = 5,
+    /// A panic: start-up or the idle loop (no interrupt handler can,
+    /// `cargo xtask isr-proof`); the panic handler left its mark and reset.
+    Panic = 6,
 }
 
 impl ResetCause {
@@ -83,13 +85,14 @@ impl ResetCause {
             3 => Self::Watchdog,
             4 => Self::HardFault,
             5 => Self::Software,
+            6 => Self::Panic,
             _ => Self::None,
         }
     }
 
-    /// The board restarted after a fault (watchdog or hard fault).
+    /// The board restarted after a fault (watchdog, hard fault or panic).
     pub fn is_recovery(self) -> bool {
-        matches!(self, Self::Watchdog | Self::HardFault)
+        matches!(self, Self::Watchdog | Self::HardFault | Self::Panic)
     }
 }
 

@@ -495,3 +495,60 @@ fn agrees_with_allantools() {
         assert!((a - b).abs() / b < 1e-9, "tau {t}: {a} vs allantools {b}");
     }
 }
+
+/// The series analysed is the output less the reference; a reference that
+/// turns is `not_static`, and a plain static record has no warning. (The
+/// `too_short` rule is unit-tested in noise/record_checks.rs.)
+#[test]
+fn rate_less_reference_and_the_record_warnings() {
+    let d = common::dir("allan-warn");
+    // White noise of 1e-3 deg/s at 100 Hz from a small LCG (Box-Muller).
+    let mut x = 12345u64;
+    let mut u = move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    let noise: Vec<f64> = (0..2000)
+        .map(|_| 1e-3 * (-2.0 * u().ln()).sqrt() * (std::f64::consts::TAU * u()).cos())
+        .collect();
+    let write = |name: &str, rows: &mut dyn Iterator<Item = String>| {
+        let p = d.join(name);
+        let body: String = rows.collect();
+        std::fs::write(&p, format!("t_s,ref_rate_dps,rate_dps\n{body}")).unwrap();
+        p.display().to_string()
+    };
+    let warnings = |p: &str| -> (Vec<String>, serde_json::Value) {
+        let v = common::json(&lab_ok(&["allan", "--data", p, "--json"]));
+        let codes = v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w["code"].as_str().unwrap().to_owned())
+            .collect();
+        (codes, v)
+    };
+    // A rate table stepping 0 -> 50 deg/s with a 10 ppm scale-factor
+    // error: the analysis sees the gyro's error, and the warning.
+    let table = write(
+        "table.csv",
+        &mut noise.iter().enumerate().map(|(k, n)| {
+            let w = if k < 1000 { 0.0 } else { 50.0 };
+            format!("{},{w},{}\n", k as f64 * 0.01, w * (1.0 + 1e-5) + n)
+        }),
+    );
+    let (codes, v) = warnings(&table);
+    assert_eq!(codes, vec!["not_static"], "{v}");
+    assert_eq!(v["analysed"], "rate_dps - ref_rate_dps");
+    assert!(v["mean_dps"].as_f64().unwrap().abs() < 1e-3, "{v}");
+    // At rest: the same noise, no warning.
+    let rest = write(
+        "rest.csv",
+        &mut noise
+            .iter()
+            .enumerate()
+            .map(|(k, n)| format!("{},0.004178,{}\n", k as f64 * 0.01, 0.004178 + n)),
+    );
+    assert_eq!(warnings(&rest).0, Vec::<String>::new());
+}

@@ -91,6 +91,30 @@ fn clean_capture_round_trips() {
     assert_eq!(written["frames"], 2_000);
 }
 
+/// Without --json, on a stderr that is not a terminal (here a pipe): the
+/// progress as plain lines, never a terminal's escape codes; the summary
+/// on stdout.
+#[test]
+fn progress_on_a_pipe_has_no_escape_codes() {
+    let s = stream(500);
+    let d = dir("pipe");
+    let capture = d.join("capture.bin");
+    std::fs::write(&capture, &s.bytes).unwrap();
+    let (code, stdout, stderr) = lab(&[
+        "record",
+        "--from",
+        capture.to_str().unwrap(),
+        "--out",
+        d.join("rec").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        !stderr.contains('\x1b') && !stderr.contains('\r'),
+        "{stderr:?}"
+    );
+    assert!(stdout.contains("500 frames"), "{stdout}");
+}
+
 /// Damage of every kind: exactly the destroyed frames reported lost, the
 /// rows after the gaps spanning them, the angle at the end the clean one's.
 #[test]

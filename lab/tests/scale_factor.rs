@@ -4,7 +4,7 @@
 
 mod common;
 mod report_check;
-use common::{lab, lab_ok};
+use common::{json, lab, lab_ok};
 
 use gyro_coeffs::fog_scale_factor::MAX_NODES;
 use gyro_lab::bench::scale_factor::{continuous_fit_test, multipoint_test, validation_test};
@@ -277,7 +277,7 @@ fn command_line_round_trip() {
         &p("sf.toml"),
         "--json",
     ]);
-    let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
+    let v = json(&out);
     for key in ["knees_c", "knees_ci_c", "residual_ppm", "segments"] {
         assert!(v.get(key).is_some(), "{key} missing: {v}");
     }
@@ -396,8 +396,8 @@ fn bad_input_is_one_line_and_exit_2() {
 }
 
 /// The scale-factor reports: `fit scale-factor` (continuous and
-/// multi-point) and `compensate` write a self-contained report.html
-/// beside their output whose plots have axes, units and data and whose
+/// multi-point) and `compensate` write a self-contained report beside
+/// their output, named after it, whose plots have axes, units and data and whose
 /// verdict's numbers and warnings are the JSON's.
 #[test]
 fn fit_and_compensate_reports() {
@@ -430,7 +430,7 @@ fn fit_and_compensate_reports() {
             "--json",
         ]);
         let v = common::json(&stdout);
-        let report = d.join(dir).join("report.html");
+        let report = d.join(dir).join("sf.html");
         assert_eq!(
             v["report"].as_str(),
             Some(report.display().to_string().as_str())
@@ -477,7 +477,7 @@ fn fit_and_compensate_reports() {
     ]);
     let v = common::json(&stdout);
     assert!(v["comp_ppm"].as_f64().unwrap() < 1.0, "{v}");
-    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("val_comp.html")).unwrap();
     report_check::check(&html, &v, 4, 10);
     // The steps run stays inside the calibrated range. (Its residual may be
     // warned about: the simulated gyro's 1 ppm asymmetry, which the fit's
@@ -517,7 +517,7 @@ fn reports_warn_on_runs_built_to_trigger_it() {
     let v = common::json(&stdout);
     let k = v["knees_c"][0].as_f64().unwrap();
     assert!((k - 56.0).abs() < 0.5, "{v}");
-    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("edge.html")).unwrap();
     let kinds = report_check::assert_warnings_match(&html, &v);
     assert!(kinds.iter().any(|k| k == "knee_near_edge"), "{kinds:?}");
     report_check::check(&html, &v, 6, 10);
@@ -555,7 +555,7 @@ fn reports_warn_on_runs_built_to_trigger_it() {
         let (lo, hi) = (s["min_c"].as_f64().unwrap(), s["max_c"].as_f64().unwrap());
         assert!(lo < 1.0 || hi > 29.0, "{s}");
     }
-    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("val_comp.html")).unwrap();
     let kinds = report_check::assert_warnings_match(&html, &v);
     assert!(
         kinds.iter().any(|k| k == "outside_calibrated_range"),

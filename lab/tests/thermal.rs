@@ -128,9 +128,45 @@ fn bad_coefficient_file() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
+/// A record too short to fit (the QEMU run's 2.4 s) is refused in one line
+/// that says what is wrong and what to do: no coefficient dump.
+#[test]
+fn too_short_to_fit_says_what_to_do() {
+    let d = dir();
+    let run = d.join("short.csv");
+    let rows: String = (0..1200)
+        .map(|k| {
+            format!(
+                "{},0,{},20,20.01,20\n",
+                k as f64 * 0.002,
+                1e-4 * (k % 7) as f64
+            )
+        })
+        .collect();
+    std::fs::write(
+        &run,
+        format!("t_s,ref_rate_dps,rate_dps,t_mono_a_c,t_mono_b_c,t_case_c\n{rows}"),
+    )
+    .unwrap();
+    let (code, _, err) = common::lab(&[
+        "fit",
+        "thermal",
+        "--data",
+        &run.display().to_string(),
+        "--out",
+        &d.join("short.toml").display().to_string(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("too short to fit: 2.4 s"), "{err}");
+    assert!(err.contains("simulate chamber --profile cycle"), "{err}");
+    assert!(!err.contains('{'), "{err}");
+}
+
 mod report_check;
 
-/// `fit thermal` and `compensate` write report.html beside their output:
+/// `fit thermal` and `compensate` write their reports beside their output,
+/// named after it (both kept in one folder):
 /// self-contained, every plot with axes, units and data, the verdict's
 /// numbers the JSON's. A soak at one temperature leaves the temperature
 /// terms unresolved: the report says so.
@@ -155,7 +191,7 @@ fn reports_and_their_warnings() {
         "--out",
         &p("f/c.toml"),
     ]);
-    let html = std::fs::read_to_string(d.join("f").join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("f").join("c.html")).unwrap();
     report_check::check(&html, &v, 4, 12);
     assert!(html.contains("Allan deviation of the residual against the noise floor"));
     // Compensating the fit run itself.
@@ -168,7 +204,7 @@ fn reports_and_their_warnings() {
         "--out",
         &p("comp.csv"),
     ]);
-    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("comp.html")).unwrap();
     report_check::check(&html, &v, 2, 6);
     // A soak: dT, T_K and their rates hardly move.
     lab_json(&[
@@ -192,7 +228,7 @@ fn reports_and_their_warnings() {
         "--out",
         &p("s/c.toml"),
     ]);
-    let html = std::fs::read_to_string(d.join("s").join("report.html")).unwrap();
+    let html = std::fs::read_to_string(d.join("s").join("c.html")).unwrap();
     let kinds = report_check::assert_warnings_match(&html, &v);
     assert!(
         kinds.iter().filter(|k| *k == "term_not_resolved").count() >= 3,
@@ -202,16 +238,22 @@ fn reports_and_their_warnings() {
     // The soak's coefficients on the cycle: the run leaves the one
     // temperature the fit saw, and the compensation report says where.
     std::fs::create_dir_all(d.join("sc")).unwrap();
-    let v = lab_json(&[
-        "compensate",
-        "--coeffs",
-        &p("s/c.toml"),
-        "--data",
-        &p("fit.csv"),
-        "--out",
-        &p("sc/comp.csv"),
-    ]);
-    let html = std::fs::read_to_string(d.join("sc").join("report.html")).unwrap();
+    let soak_on_cycle = |out: &str| {
+        lab_json(&[
+            "compensate",
+            "--coeffs",
+            &p("s/c.toml"),
+            "--data",
+            &p("fit.csv"),
+            "--out",
+            &p(out),
+        ])
+    };
+    let v = soak_on_cycle("sc/comp.csv");
+    let html = std::fs::read_to_string(d.join("sc").join("comp.html")).unwrap();
+    // The fit's report in the same folder as another command's survives.
+    soak_on_cycle("s/comp.csv");
+    assert!(d.join("s").join("c.html").exists() && d.join("s").join("comp.html").exists());
     report_check::check(&html, &v, 2, 8);
     let kinds = report_check::assert_warnings_match(&html, &v);
     assert!(

@@ -43,7 +43,7 @@ use gyro_fw::app::{
     FOG_SF_RECORD, FRAME_QUEUE_LEN, HALF_PERIODS, RLG_HZ, RLG_QUEUE_LEN, RLG_RECORD, SENSOR_EVERY,
 };
 use gyro_fw::i2c::I2c1;
-use gyro_fw::reset_cause::{reset_cause, HARD_FAULT_MARK};
+use gyro_fw::reset_cause::{reset_cause, HARD_FAULT_MARK, PANIC_MARK};
 use gyro_fw::sampling::{self, AdcBuffer, DacBuffer, Sampling};
 use gyro_fw::timing;
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
@@ -89,6 +89,14 @@ static RLG_TICKS: AtomicU32 = AtomicU32::new(0);
 /// which the cause ignores).
 #[link_section = ".uninit.RESET_MARK"]
 static RESET_MARK: AtomicU32 = AtomicU32::new(0);
+/// Where the hard fault was (its PC and LR), left beside the mark and
+/// logged by the next start: the fault handler itself logs nothing, so it
+/// has no path to a panic (`cargo xtask isr-proof`) and cannot fault again
+/// in the logger.
+#[link_section = ".uninit.RESET_MARK"]
+static FAULT_PC: AtomicU32 = AtomicU32::new(0);
+#[link_section = ".uninit.RESET_MARK"]
+static FAULT_LR: AtomicU32 = AtomicU32::new(0);
 
 /// The closure task's state.
 pub struct Closure {
@@ -303,7 +311,13 @@ mod app {
             sf_cfg,
             cause,
         );
-        if cause != ResetCause::PowerOn {
+        if cause == ResetCause::HardFault {
+            defmt::error!(
+                "started after a HardFault at pc {=u32:#x}, lr {=u32:#x}",
+                FAULT_PC.load(Ordering::Relaxed),
+                FAULT_LR.load(Ordering::Relaxed)
+            );
+        } else if cause != ResetCause::PowerOn {
             defmt::warn!("started after a reset: {}", cause as u8);
         }
         let mut watchdog = IndependentWatchdog::new(dp.IWDG);
@@ -458,25 +472,29 @@ fn reset() -> ! {
     cortex_m::peripheral::SCB::sys_reset()
 }
 
-/// Safe path of a hard fault: log where, leave the mark, reset; the first
-/// frame after the restart says `HardFault` (and RESET_RECOVERED).
+/// Safe path of a hard fault: leave the mark and where it was, reset; the
+/// next start logs where, and its first frame says `HardFault` (and
+/// RESET_RECOVERED).
 #[cortex_m_rt::exception]
 unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    FAULT_PC.store(ef.pc(), Ordering::Relaxed);
+    FAULT_LR.store(ef.lr(), Ordering::Relaxed);
     RESET_MARK.store(HARD_FAULT_MARK, Ordering::Relaxed);
-    defmt::error!("HardFault at pc {=u32:#x}, lr {=u32:#x}", ef.pc(), ef.lr());
     cortex_m::peripheral::SCB::sys_reset()
 }
 
-/// Safe path: stop the interrupts (the modulator DMA keeps cycling the last
-/// words, a valid square wave), log, and let the watchdog restart the board;
-/// the first frame after restart carries RESET_RECOVERED.
+/// Safe path of a panic, which only start-up and the idle loop can reach
+/// (no interrupt handler has a path to one: `cargo xtask isr-proof`): stop
+/// the interrupts (the modulator DMA keeps cycling the last words, a valid
+/// square wave), log where, leave the mark and reset at once (before
+/// start-up has armed the watchdog nothing else would). The first frame
+/// after the restart says `Panic` and carries RESET_RECOVERED.
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     if let Some(l) = info.location() {
         defmt::error!("panic at {}:{}", l.file(), l.line());
     }
-    loop {
-        cortex_m::asm::nop();
-    }
+    RESET_MARK.store(PANIC_MARK, Ordering::Relaxed);
+    cortex_m::peripheral::SCB::sys_reset()
 }

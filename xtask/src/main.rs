@@ -1,7 +1,9 @@
 //! `cargo xtask qemu | test | bench`: developer entry points. Each first installs
 //! what it needs (thumbv7em target, qemu-system-arm, flip-link, defmt-print).
 
+mod capture;
 mod frames;
+mod panic_paths;
 mod record_test;
 mod setup;
 
@@ -19,8 +21,12 @@ fn main() {
         Some("bench") => bench_cmd(),
         // The board-to-lab tests alone (part of `test`).
         Some("record-test") => record_test_cmd(),
+        // The interrupt handlers' freedom from panics (part of `test`).
+        Some("isr-proof") => isr_proof_cmd(),
+        // The README's lab walkthrough, top to bottom (part of `test`).
+        Some("readme") => readme_cmd(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu|test|bench>");
+            eprintln!("usage: cargo xtask <qemu|test|bench|record-test|isr-proof|readme>");
             std::process::exit(2);
         }
     };
@@ -76,6 +82,9 @@ pub fn build_firmware(board: &str) -> Result<PathBuf> {
         .join(format!("gyro-fw-{board}")))
 }
 
+/// QEMU's clock: instruction-counted, never the host's (see [`qemu_command`]).
+pub const QEMU_ICOUNT: &str = "shift=0,sleep=off";
+
 /// Output of one QEMU run.
 pub struct QemuRun {
     pub log: String,
@@ -90,8 +99,16 @@ pub const QEMU_STALL: std::time::Duration = std::time::Duration::from_secs(60);
 /// And no run takes longer than this at all.
 pub const QEMU_LIMIT: std::time::Duration = std::time::Duration::from_secs(20 * 60);
 
-/// qemu-system-arm on the `qemu` firmware, deterministic (-icount
-/// shift=0); `serial`: QEMU's -serial argument (a file, or `pty`).
+/// qemu-system-arm on the `qemu` firmware, deterministic; `serial`: QEMU's
+/// -serial argument (a file, or `pty`). Every QEMU run is made here.
+///
+/// `-icount shift=0`: one instruction is 1 ns of virtual time, so SysTick and
+/// TIM2 count instructions. `sleep=off`: while the guest sleeps in WFI the
+/// virtual clock jumps to the next timer deadline. With icount's default
+/// (`sleep=on`) it runs on the host's real time there, so how late the next
+/// interrupt lands, and every frame after it, would depend on the host's
+/// speed and load. A guest blocked on a full serial backend (a slow reader
+/// on the pty) executes nothing, so its clock stands still there too.
 pub fn qemu_command(elf: &Path, serial: &str) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args([
@@ -107,7 +124,7 @@ pub fn qemu_command(elf: &Path, serial: &str) -> Command {
         "-semihosting-config",
         "enable=on,target=native",
         "-icount",
-        "shift=0",
+        QEMU_ICOUNT,
     ])
     .arg("-serial")
     .arg(serial)
@@ -155,7 +172,7 @@ pub fn wait_progressing(
     }
 }
 
-/// Runs the `qemu` firmware deterministically (-icount shift=0) and decodes defmt.
+/// Runs the `qemu` firmware deterministically ([`QEMU_ICOUNT`]) and decodes defmt.
 pub fn run_qemu() -> Result<QemuRun> {
     let elf = build_firmware("qemu")?;
     let dir = root().join("runs");
@@ -233,7 +250,7 @@ fn test_cmd() -> Result<()> {
         .args(FIRMWARE)
         .args(["--lib", "--", "-D", "warnings"]))?;
     run(cargo().args(["test", "--workspace", "--profile", "host-test"]))?;
-    build_firmware("hw")?;
+    isr_proof(&build_firmware("hw")?)?;
     // Tests of the firmware under QEMU.
     let qrun = run_qemu()?;
     let report = frames::analyse(&qrun.frames_path)?;
@@ -250,7 +267,61 @@ fn test_cmd() -> Result<()> {
     if failed > 0 {
         bail!("{failed} firmware test(s) under QEMU failed");
     }
-    record_tests(&qrun)
+    record_tests(&qrun)?;
+    readme_cmd()
+}
+
+/// `cargo xtask readme`: the README's "The lab, step by step", every
+/// command as written, in a scratch folder (scripts/readme-walkthrough.sh).
+fn readme_cmd() -> Result<()> {
+    run(Command::new("sh").arg(root().join("scripts/readme-walkthrough.sh")))
+}
+
+/// The interrupts that must exist in the hw image: the FOG closure (ADC
+/// DMA) and the RLG update (TIM5).
+const HW_HANDLERS: [&str; 2] = ["DMA2_STREAM0", "TIM5"];
+
+/// No interrupt handler of the hw release image reaches a panic
+/// (`panic_paths.rs`): each handler in its vector table is checked.
+fn isr_proof(elf: &Path) -> Result<()> {
+    let proof = panic_paths::check(elf)?;
+    let verdicts = &proof.handlers;
+    for h in HW_HANDLERS {
+        if !verdicts.iter().any(|(name, _)| name == h) {
+            bail!("the hw image's vector table has no {h} handler");
+        }
+    }
+    if let Some(p) = &proof.entry {
+        println!("isr proof: start-up may panic (a reset, docs/panics.md), e.g. {p}");
+    }
+    match &proof.idle {
+        Some(None) => println!("isr proof: the idle loop has no path to a panic"),
+        Some(Some(p)) => println!("isr proof: the idle loop may panic (a reset), e.g. {p}"),
+        None => {}
+    }
+    let mut failed = 0;
+    for (name, path) in verdicts {
+        match path {
+            None => println!("isr proof {name} ... ok (no path to a panic)"),
+            Some(p) => {
+                failed += 1;
+                println!("isr proof {name} ... FAILED: {p}");
+            }
+        }
+    }
+    if failed > 0 {
+        bail!(
+            "{failed} interrupt handler(s) of {} can panic",
+            elf.display()
+        );
+    }
+    Ok(())
+}
+
+/// `cargo xtask isr-proof`: the proof alone, on a fresh hw build.
+fn isr_proof_cmd() -> Result<()> {
+    setup::ensure_all()?;
+    isr_proof(&build_firmware("hw")?)
 }
 
 /// `cargo xtask record-test`: the QEMU run and the board-to-lab tests.
@@ -265,7 +336,12 @@ fn record_test_cmd() -> Result<()> {
 fn record_tests(qrun: &QemuRun) -> Result<()> {
     let clean = record_qemu_run(qrun)?;
     run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
-    let checks = record_test::run(&qrun.elf, &clean, &root().join("runs/qemu-reference.csv"))?;
+    let checks = record_test::run(
+        &qrun.elf,
+        &clean,
+        &qrun.frames_path,
+        &root().join("runs/qemu-reference.csv"),
+    )?;
     let failed = checks.iter().filter(|c| !c.1).count();
     for (name, ok, detail) in &checks {
         println!(

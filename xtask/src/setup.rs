@@ -1,4 +1,5 @@
-//! Installs what the firmware build and the QEMU runs need, once.
+//! Installs what the firmware build, the QEMU runs and the ISR proof need,
+//! once.
 
 use crate::{run, TARGET};
 use anyhow::Result;
@@ -18,16 +19,15 @@ pub fn ensure_all() -> Result<()> {
     if !String::from_utf8_lossy(&installed.stdout).contains(TARGET) {
         run(Command::new("rustup").args(["target", "add", TARGET]))?;
     }
-    if !have("qemu-system-arm") {
-        let sudo = if have("sudo") && !is_root() {
-            "sudo "
-        } else {
-            ""
-        };
-        run(Command::new("sh").args([
-            "-c",
-            &format!("{sudo}apt-get update -q && {sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -q qemu-system-arm"),
-        ]))?;
+    // Debian's packages: the emulator, and the disassembler the ISR proof
+    // reads the image with.
+    for (cmd, package) in [
+        ("qemu-system-arm", "qemu-system-arm"),
+        ("arm-none-eabi-objdump", "binutils-arm-none-eabi"),
+    ] {
+        if !have(cmd) {
+            apt_install(package)?;
+        }
     }
     for tool in ["flip-link", "defmt-print"] {
         if !have(tool) {
@@ -35,6 +35,18 @@ pub fn ensure_all() -> Result<()> {
         }
     }
     Ok(())
+}
+
+fn apt_install(package: &str) -> Result<()> {
+    let sudo = if have("sudo") && !is_root() {
+        "sudo "
+    } else {
+        ""
+    };
+    run(Command::new("sh").args([
+        "-c",
+        &format!("{sudo}apt-get update -q && {sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -q {package}"),
+    ]))
 }
 
 fn is_root() -> bool {

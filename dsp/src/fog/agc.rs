@@ -9,8 +9,14 @@
 use super::residual::Sine;
 use crate::fixed::smmul;
 use crate::phase::RAD_PER_PHASE_LSB;
+use core::num::NonZeroU32;
 #[allow(unused_imports)] // f64 maths comes from libm where core lacks it
 use num_traits::float::Float;
+
+/// The DC filter's time constant, closures: the update's shift of its Q12
+/// state (`dc - dc >> 12 + flat`). The slowest loop of the closure: what
+/// starts with it (a run's first DC under vibration) decays at this rate.
+pub const DC_FILTER_CLOSURES: u32 = 1 << 12;
 
 /// Largest kept-sample sum of one half period, ADC LSB (15 kept samples of
 /// 16-bit codes), so the Q12 DC filter fits a u32.
@@ -30,6 +36,9 @@ pub struct AgcConfig {
     /// moment m (ADC LSB x phase LSB), Q60: -(cot(phi0)/(2n)) * 2*pi/2^32;
     /// below 2^31 for every valid depth (|cot| <= 10, n >= 4).
     pub moment_q60: i32,
+    /// Half periods per closure, non-zero by its type: the DC's division
+    /// cannot fault in the closure.
+    pub n_half: NonZeroU32,
 }
 
 impl AgcConfig {
@@ -55,14 +64,19 @@ impl AgcConfig {
             moment_q60: (moment * (1u64 << 60) as f64)
                 .round()
                 .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            // FogConfig refuses a layout without half periods before this.
+            n_half: NonZeroU32::new(n_half as u32).unwrap_or(NonZeroU32::MIN),
         }
     }
 
     /// Detector DC of one half period, dark level removed, from the
-    /// closure's kept-sample sum over `n_half` half periods.
+    /// closure's kept-sample sum over its half periods: `H` of them when the
+    /// closure's kernel knows the layout at compile time (a constant
+    /// divisor), else the configuration's.
     #[inline(always)]
-    pub fn dc_half(&self, dc_sum: u32, n_half: usize) -> u32 {
-        (dc_sum / n_half as u32).saturating_sub(self.dark_half)
+    pub fn dc_half<const H: usize>(&self, dc_sum: u32) -> u32 {
+        let n = NonZeroU32::new(H as u32).unwrap_or(self.n_half);
+        (dc_sum / n).saturating_sub(self.dark_half)
     }
 }
 

@@ -217,7 +217,7 @@ impl FogLoop {
         };
         let sums =
             demodulate::<H, S, SKIP>(adc, samples_per_half, skip, n_half, &self.applied.resets);
-        let dc_half = cfg.agc.dc_half(sums.dc, n_half);
+        let dc_half = cfg.agc.dc_half::<H>(sums.dc);
         let power_low = dc_half < cfg.agc.h0_min;
         self.faults.set(Faults::OPTICAL_POWER_LOW, power_low);
         self.faults.set(Faults::ADC_SATURATION, adc_over_range);

@@ -373,7 +373,7 @@ pub struct LockIn {
     /// Omega_I/Omega_L of the estimate.
     pub rate_ratio: f64,
     /// The fit's relative one-sigma uncertainty of the lock-in rate, and
-    /// the Cramer-Rao bound for this record (physics.md 2.1: sigma/(sqrt(N)
+    /// the Cramer-Rao bound for this record (docs/lockin.md: sigma/(sqrt(N)
     /// A rho) from the pair with unknown offsets, sqrt(2) more from one
     /// channel; the small-lock-in form, exact for Omega_I/Omega_L >= 10).
     pub lock_in_rel_std: f64,
@@ -390,7 +390,7 @@ pub struct LockIn {
 }
 
 /// The small-lock-in Cramer-Rao bound on the relative error of Omega_L
-/// (physics.md 2.1): `sigma/(sqrt(N) A rho)` from the quadrature pair with
+/// (docs/lockin.md): `sigma/(sqrt(N) A rho)` from the quadrature pair with
 /// unknown offsets, sqrt(2) more from one channel.
 pub fn cramer_rao_rel(noise_over_amplitude: f64, samples: usize, rho: f64, channels: usize) -> f64 {
     let one = if channels >= 2 { 1.0 } else { 2f64.sqrt() };

@@ -10,6 +10,7 @@ use crate::error::LabError;
 use crate::noise::analysis::{analyse, Allan};
 use crate::noise::gaps::{fill_gaps, Filled};
 use crate::noise::model::Interval;
+use crate::noise::record_checks::{self, RecordWarning};
 use crate::noise::terms::{self, shape_name, COUNT, MARKOV_NAME, NAMES, SIN_NAME, SLOPES, UNITS};
 use crate::report::document::Report;
 use crate::report::plot::Axes;
@@ -25,7 +26,8 @@ pub struct AllanArgs {
     /// Run file (t_s and the rate column, deg/s).
     #[arg(long)]
     pub data: PathBuf,
-    /// The rate column to analyse, deg/s.
+    /// The rate column to analyse, deg/s; less `ref_rate_dps` where the
+    /// file has it.
     #[arg(long, default_value = Column::Rate.name())]
     pub column: String,
     #[command(flatten)]
@@ -129,28 +131,51 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let series = RunSeries::read(&a.data, &a.column)?;
+    let mut series = RunSeries::read(&a.data, &a.column)?;
     let read_s = t_start.elapsed().as_secs_f64();
     spinner.set_message("Allan variance");
+    // The gyro's error, not the table's motion: the output less the
+    // reference rate where the file has one.
+    let mut warnings: Vec<RecordWarning> = vec![];
+    let analysed = match &series.reference {
+        Some(r) => {
+            warnings.extend(record_checks::not_static(r));
+            for (v, r) in series.values.iter_mut().zip(r) {
+                *v -= r;
+            }
+            format!("{} - {}", a.column, Column::RefRate.name())
+        }
+        None => a.column.clone(),
+    };
     let filled = fill_gaps(&series.t_s, &series.values)
         .map_err(|e| series.time_error(e.row(), e.to_string()))?;
     let name = a.data.display().to_string();
     let an = analyse(&filled.values, filled.tau0)
-        .map_err(|e| LabError::input(&a.data, format!("column `{}`: {e}", a.column)))?;
+        .map_err(|e| LabError::input(&a.data, format!("column `{analysed}`: {e}")))?;
+    warnings.extend(record_checks::too_short(&an));
     let compute_s = t_start.elapsed().as_secs_f64() - read_s;
     spinner.finish_and_clear();
     if let Some(dir) = &a.out.out {
         std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
         write_csv(&an, &dir.join("allan.csv"))?;
-        write_report(&report(&an, &name, &a.column), &dir.join("report.html"))?;
+        write_report(
+            &report(&an, &name, &analysed, &warnings),
+            &dir.join("report.html"),
+        )?;
     }
     let timing = (read_s, compute_s);
     if a.json.json {
-        println!("{}", json(&an, &a.column, &filled, timing));
+        let mut j = json(&an, &a.column, &filled, timing);
+        j["analysed"] = analysed.into();
+        j["warnings"] = serde_json::to_value(&warnings).unwrap_or_default();
+        println!("{j}");
         return Ok(());
     }
-    print_text(&an, &name, a, timing);
-    if filled.gaps > 0 {
+    print_text(&an, &name, a, &analysed, timing);
+    for w in &warnings {
+        println!("WARNING ({}): {}", w.code, w.message);
+    }
+    if filled.gaps + filled.stretched > 0 {
         println!("{}", gaps_text(&filled));
     }
     Ok(())
@@ -190,6 +215,7 @@ fn json(
         "column": column,
         "gaps": {
             "count": filled.gaps,
+            "stretched_intervals": filled.stretched,
             "filled_samples": filled.filled,
             "filled_fraction": filled.filled_fraction(),
         },
@@ -200,14 +226,26 @@ fn json(
 
 /// What filling the record's gaps did, and what it costs.
 fn gaps_text(f: &Filled) -> String {
-    format!(
-        "gaps: {} in the record, {} samples ({:.3} % of the series) filled with the rate over each gap; \
-         the angle is kept, so averages spanning a gap are right, but the noise inside the gaps is \
-         missing and deviations at averaging times shorter than a gap read low by up to that share",
-        f.gaps,
-        f.filled,
-        100.0 * f.filled_fraction()
-    )
+    let mut parts = vec![];
+    if f.gaps > 0 {
+        parts.push(format!(
+            "gaps: {} in the record (samples lost on the way), {} samples ({:.3} % of the series) filled \
+             with the rate over each gap; the angle is kept, so averages spanning a gap are right, but the \
+             noise inside the gaps is missing and deviations at averaging times shorter than a gap read low \
+             by up to that share",
+            f.gaps,
+            f.filled,
+            100.0 * f.filled_fraction()
+        ));
+    }
+    if f.stretched > 0 {
+        parts.push(format!(
+            "{} interval(s) longer than the sample period by less than half of one (a frame spanning \
+             closures the board missed; no sample lost): resampled through the angle",
+            f.stretched
+        ));
+    }
+    parts.join("; ")
 }
 
 /// The verdict on the fit, one sentence.
@@ -411,11 +449,17 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
     rows
 }
 
-fn print_text(an: &Allan, name: &str, a: &AllanArgs, (read_s, compute_s): (f64, f64)) {
+fn print_text(
+    an: &Allan,
+    name: &str,
+    a: &AllanArgs,
+    analysed: &str,
+    (read_s, compute_s): (f64, f64),
+) {
     println!(
-        "{}: column `{}`, {} samples at {} s ({:.4} h); {} averaging times {} .. {} s",
+        "{}: `{}`, {} samples at {} s ({:.4} h); {} averaging times {} .. {} s",
         name,
-        a.column,
+        analysed,
         an.n,
         sig(an.tau0),
         an.n as f64 * an.tau0 / 3600.0,
@@ -473,8 +517,11 @@ fn write_csv(an: &Allan, path: &std::path::Path) -> Result<(), LabError> {
     allan_file::write(path, &rows)
 }
 
-fn report(an: &Allan, name: &str, column: &str) -> Report {
+fn report(an: &Allan, name: &str, column: &str, warnings: &[RecordWarning]) -> Report {
     let mut r = Report::new(&format!("Allan deviation of {column} in {name}"));
+    for w in warnings {
+        r.paragraph(&format!("WARNING ({}): {}.", w.code, w.message));
+    }
     r.paragraph(&format!(
         "{} samples every {} s ({:.4} h). Overlapping Allan deviation at {} averaging times from {} s to a third \
          of the record ({} s), with 95 % chi-square intervals from Greenhall's equivalent degrees of freedom of \

@@ -259,6 +259,7 @@ fn print_families(j: &ScaleFactorBench) {
 
 #[derive(Args, Debug, Clone)]
 pub struct AllanBenchArgs {
+    /// Records per noise-term combination (each its own seed).
     #[arg(long, default_value_t = 100)]
     pub seeds: u64,
     /// The first seed (seeds first..first + seeds): another set of seeds
@@ -506,28 +507,31 @@ fn allan_speed(a: &SpeedArgs) -> Result<(), LabError> {
 
 #[derive(Args, Debug, Clone)]
 pub struct DiscoverBenchArgs {
-    /// Trials per effect of the library (14 effects), alone and near 1.5
-    /// times the noise floor.
+    /// Trials per effect of the library (14 effects), alone.
     #[arg(long, default_value_t = 8)]
     pub per_effect: u64,
+    /// Trials per effect of the library at 1.5 times the noise floor (weak effects).
     #[arg(long, default_value_t = 1)]
     pub weak: u64,
-    /// Trials with nothing missing, with two effects, with collinear ones,
-    /// nulls with coloured noise, decaying warm-ups.
+    /// Trials with nothing missing (white noise only).
     #[arg(long, default_value_t = 14)]
     pub nothing: u64,
+    /// Trials with two effects hidden at once.
     #[arg(long, default_value_t = 8)]
     pub pairs: u64,
+    /// Trials with two effects whose regressors correlate (the run cannot tell them apart).
     #[arg(long, default_value_t = 8)]
     pub collinear: u64,
+    /// Null trials with coloured noise (random walk, flicker, Markov).
     #[arg(long, default_value_t = 12)]
     pub coloured: u64,
+    /// Trials with a decaying warm-up.
     #[arg(long, default_value_t = 10)]
     pub decaying: u64,
-    /// Trials per thermal term with a bias (5 terms), per disturbance
-    /// outside the library (5).
+    /// Trials per thermal term with a bias (5 terms).
     #[arg(long, default_value_t = 3)]
     pub bias_thermal: u64,
+    /// Trials per disturbance outside the library (5 kinds).
     #[arg(long, default_value_t = 3)]
     pub outside: u64,
     #[command(flatten)]

@@ -25,6 +25,8 @@ pub struct CompensateArgs {
     /// Coefficient file (from `gyro-lab fit`).
     #[arg(long)]
     pub coeffs: PathBuf,
+    /// Run file to compensate (t_s, rate_dps, and the temperature columns the
+    /// coefficients need).
     #[arg(long)]
     pub data: PathBuf,
     #[command(flatten)]

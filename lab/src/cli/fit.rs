@@ -5,7 +5,7 @@
 use crate::calibration::scale_factor::diagnostics::diagnostics;
 use crate::calibration::scale_factor::fit::fit;
 use crate::calibration::scale_factor::multipoint::Plateau;
-use crate::calibration::scale_factor::result::{Segment, SfFit};
+use crate::calibration::scale_factor::result::SfFit;
 use crate::calibration::thermal::summary::{calibrate, FitSummary};
 use crate::cli::args::{Json, NoReport, Out};
 use crate::cli::output::{print_json, write_report};
@@ -84,15 +84,7 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
     } else {
         let v = s.coefficients.values();
         let e = s.coefficient_se.map(|c| c.values());
-        let names = [
-            "bias0_dph",
-            "k1_dph_per_c",
-            "k2_dph_per_c_per_s",
-            "k3_dph_per_c2",
-            "k4_dph_per_c",
-            "k5_dph",
-            "tau_warm_s",
-        ];
+        let names = gyro_sp::rlg::ThermalCoeffs::NAMES;
         for (k, n) in names.iter().enumerate() {
             match e {
                 Some(e) => println!("  {n:<20} {:>12.6} +- {:.6}", v[k], e[k]),
@@ -144,7 +136,7 @@ struct FitJson<'a> {
     knees_ci_c: Vec<[f64; 2]>,
     residual_ppm: f64,
     residual_ppm_se: f64,
-    segments: &'a [Segment],
+    /// The fit itself, `segments`, `model` and `degree` among its keys.
     #[serde(flatten)]
     fit: &'a SfFit,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -167,12 +159,14 @@ struct TableJson {
 pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
     let inp = scale_factor_run(&a.data)?;
     let (f, plateaus) = fit(&inp).map_err(|e| LabError::input(&a.data, e.to_string()))?;
-    f.table.check().map_err(|e| {
+    f.table.check().map_err(|_| {
         LabError::input(
             &a.data,
             format!(
-                "the fitted table is out of the firmware's range ({e:?}): {:?}",
-                f.table
+                "the fitted table is outside what the firmware holds ({}): this run does not \
+                 determine the scale factor over temperature; fit on a continuous-rotation run at \
+                 50 deg/s or more through the chamber's range (e.g. `gyro-lab simulate scale-factor`)",
+                table_problem(&f.table)
             ),
         )
     })?;
@@ -191,7 +185,6 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
             knees_ci_c: f.knees.iter().map(|k| [k.lo, k.hi]).collect(),
             residual_ppm: f.residual_ppm.value,
             residual_ppm_se: f.residual_ppm.se,
-            segments: &f.segments,
             fit: &f,
             plateaus: plateaus.as_deref(),
             table: TableJson {
@@ -348,4 +341,37 @@ fn print_text(f: &SfFit, crc: &str, out: &std::path::Path) {
 
 fn rounded(v: &[f64]) -> Vec<f64> {
     v.iter().map(|x| (x * 10.0).round() / 10.0).collect()
+}
+
+/// The first value of a fitted scale-factor table outside the firmware's
+/// ranges, in words (gyro-coeffs' `check` says only that one is).
+fn table_problem(t: &gyro_coeffs::ScaleFactorTable) -> String {
+    use gyro_coeffs::fog_scale_factor::{
+        BIAS_LIMIT_DPH, LAG_LIMIT_S, MAX_NODES, MIN_NODE_GAP_C, SF_LIMIT_PPM, T_MAX_C, T_MIN_C,
+    };
+    let n = t.n;
+    if !(1..=MAX_NODES).contains(&n) {
+        return format!("{n} nodes, 1 to {MAX_NODES} allowed");
+    }
+    for k in 0..n {
+        let tc = t.temps_c[k];
+        if !(tc.is_finite() && (T_MIN_C..=T_MAX_C).contains(&tc)) {
+            return format!("node {k} at {tc:.2} degC, outside {T_MIN_C} .. {T_MAX_C}");
+        }
+        if k > 0 && tc - t.temps_c[k - 1] < MIN_NODE_GAP_C {
+            return format!("nodes {} and {k} closer than {MIN_NODE_GAP_C} degC", k - 1);
+        }
+        let sf = t.sf_ppm[k];
+        if !(sf.is_finite() && sf.abs() <= SF_LIMIT_PPM) {
+            return format!("scale-factor error {sf:.4e} ppm at node {k}, limit +-{SF_LIMIT_PPM}");
+        }
+        let b = t.bias_dph[k];
+        if !(b.is_finite() && b.abs() <= BIAS_LIMIT_DPH) {
+            return format!("bias {b:.4e} deg/h at node {k}, limit +-{BIAS_LIMIT_DPH}");
+        }
+    }
+    format!(
+        "coil-sensor lag {:.4e} s, limit 0 .. {LAG_LIMIT_S}",
+        t.sensor_lag_s
+    )
 }

@@ -81,3 +81,31 @@ pub fn run(cli: &Cli) -> Result<(), LabError> {
         Cmd::Bench(c) => bench::run(c),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// Every option of every command says what it is in `--help`.
+    #[test]
+    fn every_option_has_help() {
+        fn walk(cmd: &clap::Command, path: &str, blank: &mut Vec<String>) {
+            for a in cmd.get_arguments() {
+                let id = a.get_id().as_str();
+                if id == "help" || id == "version" {
+                    continue;
+                }
+                if a.get_help().is_none() && a.get_long_help().is_none() {
+                    blank.push(format!("{path} --{id}"));
+                }
+            }
+            for s in cmd.get_subcommands() {
+                walk(s, &format!("{path} {}", s.get_name()), blank);
+            }
+        }
+        let mut blank = vec![];
+        walk(&Cli::command(), "gyro-lab", &mut blank);
+        assert!(blank.is_empty(), "options without help: {blank:#?}");
+    }
+}

@@ -6,10 +6,11 @@
 
 use crate::cli::args::{Json, Out};
 use crate::cli::output::print_json;
-use crate::data::run_file::Column;
+use crate::data::run_file::{self, Column};
 use crate::data::table::TextTable;
 use crate::error::LabError;
 use clap::Args;
+use gyro_frames::reference::RateLogError;
 use gyro_frames::summary::Summary;
 use gyro_frames::{RateLog, RecordError, Recorder, Reference, Scales};
 use serde::Serialize;
@@ -60,6 +61,9 @@ pub struct RecordArgs {
 const READ_TIMEOUT: Duration = Duration::from_millis(100);
 /// How often the progress line is redrawn.
 const PROGRESS_EVERY: Duration = Duration::from_millis(500);
+/// On a stderr that is not a terminal (a log file, a pipe), a plain line
+/// this often instead of the redrawn one: no terminal escape codes.
+const PROGRESS_LOG_EVERY: Duration = Duration::from_secs(10);
 
 /// `record.json` and the `--json` line.
 #[derive(Serialize)]
@@ -208,12 +212,24 @@ fn reference(a: &RecordArgs) -> Result<Reference, LabError> {
     let Some(path) = &a.reference else {
         return Ok(Reference::Constant(0.0));
     };
-    let t = TextTable::read(path)?;
+    let t = TextTable::read_bounded(path, Some(run_file::bounds))?;
     let time = t.time(Column::Time.name(), 2)?;
     let rate = t.column(Column::RefRate.name())?;
     RateLog::new(time, rate, a.reference_offset_s)
         .map(Reference::Log)
-        .map_err(|e| LabError::input(path, format!("{e:?}")))
+        .map_err(|e| {
+            LabError::input(
+                path,
+                match e {
+                    RateLogError::TooShort => "fewer than two reference samples".to_string(),
+                    RateLogError::NotIncreasing { index } => {
+                        format!(
+                            "reference sample {index} is not after the one before, or not finite"
+                        )
+                    }
+                },
+            )
+        })
 }
 
 fn record_error(e: RecordError, source: &Path) -> LabError {
@@ -268,7 +284,10 @@ pub fn run(a: &RecordArgs) -> Result<(), LabError> {
         let _ = ctrlc::set_handler(move || s.store(true, Ordering::SeqCst));
     }
     let start = Instant::now();
-    let mut progress = Progress::new(!a.json.json);
+    let mut progress = Progress::new(
+        !a.json.json,
+        std::io::IsTerminal::is_terminal(&std::io::stderr()),
+    );
     let mut buf = vec![0u8; 64 * 1024];
     let mut ended: Option<LabError> = None;
     loop {
@@ -365,24 +384,32 @@ fn print_summary(j: &RecordJson, dir: &Path) {
     );
 }
 
-/// The progress line on stderr while a record runs.
+/// The progress line on stderr while a record runs: redrawn in place on a
+/// terminal, a plain line now and then anywhere else.
 struct Progress {
     shown: bool,
+    terminal: bool,
     last: Option<Instant>,
     frames_then: (u64, Duration),
 }
 
 impl Progress {
-    fn new(shown: bool) -> Self {
+    fn new(shown: bool, terminal: bool) -> Self {
         Self {
             shown,
+            terminal,
             last: None,
             frames_then: (0, Duration::ZERO),
         }
     }
 
     fn show(&mut self, rec: &Recorder, elapsed: Duration) {
-        if !self.shown || self.last.is_some_and(|t| t.elapsed() < PROGRESS_EVERY) {
+        let every = if self.terminal {
+            PROGRESS_EVERY
+        } else {
+            PROGRESS_LOG_EVERY
+        };
+        if !self.shown || self.last.is_some_and(|t| t.elapsed() < every) {
             return;
         }
         self.last = Some(Instant::now());
@@ -397,18 +424,23 @@ impl Progress {
             )
         });
         let flags: Vec<&str> = s.flags.iter().map(|f| f.name.as_str()).collect();
-        eprint!(
-            "\r\x1b[2K{:.1} s  {:.0} frames/s  {latest}  CRC errors {}  gaps {}  flags up [{}]",
+        let line = format!(
+            "{:.1} s  {:.0} frames/s  {latest}  CRC errors {}  gaps {}  flags up [{}]",
             elapsed.as_secs_f64(),
             fps,
             s.crc_errors,
             s.lost.len(),
             flags.join(" ")
         );
+        if self.terminal {
+            eprint!("\r\x1b[2K{line}");
+        } else {
+            eprintln!("{line}");
+        }
     }
 
     fn clear(&self) {
-        if self.shown && self.last.is_some() {
+        if self.shown && self.terminal && self.last.is_some() {
             eprintln!();
         }
     }

@@ -120,6 +120,34 @@ impl Column {
     }
 }
 
+/// The physical range of a run file's column, by the unit its name ends
+/// in: a value outside it is no gyro's, rate table's or sensor's (1e300
+/// deg/s would turn every sum into infinity and every answer into
+/// nothing). Time is judged by its increase instead.
+pub fn bounds(name: &str) -> Option<(f64, f64, &'static str)> {
+    if name.ends_with("_dps2") {
+        Some((
+            -1e8,
+            1e8,
+            "the angular accelerations a rig gives (|x| <= 1e8 deg/s^2)",
+        ))
+    } else if name.ends_with("_dps") {
+        Some((
+            -1e5,
+            1e5,
+            "the rates a gyro or a rate table gives (|x| <= 1e5 deg/s)",
+        ))
+    } else if name.ends_with("_c") {
+        Some((
+            -273.15,
+            1000.0,
+            "the temperatures a sensor reads (-273.15 .. 1000 degC)",
+        ))
+    } else {
+        None
+    }
+}
+
 /// The interface's columns of a run, as read: the required three, and of
 /// the others those the reader asked for and the file has.
 #[derive(Debug)]
@@ -197,7 +225,7 @@ impl RunFile {
         min_rows: usize,
         need: [Column; N],
     ) -> Result<(RunText, [Vec<f64>; N]), LabError> {
-        let table = TextTable::read(path)?;
+        let table = TextTable::read_bounded(path, Some(bounds))?;
         let t = table.time(Column::Time.name(), min_rows)?;
         let w = table.column(Column::RefRate.name())?;
         let y = table.column(Column::Rate.name())?;
@@ -228,7 +256,8 @@ impl RunFile {
     pub fn read_long(path: &Path, min_rows: usize, optional: &[Column]) -> Result<Self, LabError> {
         let required = [Column::Time, Column::RefRate, Column::Rate].map(Column::name);
         let optional_names: Vec<&str> = optional.iter().map(|c| c.name()).collect();
-        let (mut c, present) = ColumnStream::read_with(path, &required, &optional_names)?;
+        let (mut c, present) =
+            ColumnStream::read_bounded(path, &required, &optional_names, Some(bounds))?;
         if c.len() < min_rows {
             return Err(LabError::input(
                 path,
@@ -270,22 +299,41 @@ impl RunText {
 }
 
 /// One column of a run file against time, streamed (the Allan analysis of
-/// `rate_dps` or any other column a user names): `t_s` increasing.
+/// `rate_dps` or any other column a user names): `t_s` increasing; the
+/// reference rate beside it where the file has one.
 pub struct Series {
     pub t_s: Vec<f64>,
     pub values: Vec<f64>,
+    pub reference: Option<Vec<f64>>,
     stream: ColumnStream,
 }
 
 impl Series {
     pub fn read(path: &Path, column: &str) -> Result<Self, LabError> {
-        let mut stream = ColumnStream::read(path, &[Column::Time.name(), column])?;
+        let reference = Column::RefRate.name();
+        let optional: &[&str] = if column == reference {
+            &[]
+        } else {
+            &[reference]
+        };
+        let (mut stream, present) = ColumnStream::read_bounded(
+            path,
+            &[Column::Time.name(), column],
+            optional,
+            Some(bounds),
+        )?;
         stream.check_increasing(0)?;
         let t_s = std::mem::take(&mut stream.data[0]);
         let values = std::mem::take(&mut stream.data[1]);
+        let reference = present
+            .first()
+            .copied()
+            .flatten()
+            .map(|k| std::mem::take(&mut stream.data[k]));
         Ok(Self {
             t_s,
             values,
+            reference,
             stream,
         })
     }

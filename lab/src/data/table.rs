@@ -1,9 +1,12 @@
 //! Reading CSV data files by column name: CSV, one header row, `#` comment
-//! lines before it. Every cell a caller uses is checked: a missing column, a
-//! cell that is not a finite number, time that does not increase or too few
-//! rows give an error at `file:line:column` (column = 1-based field number,
-//! then its name). The file kinds (run_file.rs, fringe_file.rs) name the
-//! columns; this module knows none.
+//! lines before it. Every row must have as many cells as the header: a row
+//! with one more or one less would shift or drop a column, and the answer
+//! would change without a word. Every cell a caller uses is checked: a
+//! missing column (at the header's own line), a cell that is not a finite
+//! number, time that does not increase or too few rows give an error at
+//! `file:line:column` (column = 1-based field number, then its name). The
+//! file kinds (run_file.rs, fringe_file.rs) name the columns; this module
+//! knows none.
 //!
 //! Two readers: [`TextTable`] keeps the file as text cells (unused columns
 //! are written back as read) and checks column by column; [`ColumnStream`]
@@ -12,11 +15,17 @@
 use crate::error::{ColumnRef, LabError};
 use std::path::{Path, PathBuf};
 
+/// The physical range of a column's values, looked up by its name (the
+/// file kinds know their columns; this module knows none): `(lo, hi,
+/// what)`, `what` naming the range in the error.
+pub type Bounds = fn(&str) -> Option<(f64, f64, &'static str)>;
+
 /// What is wrong with a cell that should hold a number.
 enum CellError<'a> {
     NotFinite(&'a str),
     Empty,
     NotANumber(&'a str),
+    OutOfRange(&'a str, &'static str),
 }
 
 impl std::fmt::Display for CellError<'_> {
@@ -25,18 +34,63 @@ impl std::fmt::Display for CellError<'_> {
             CellError::NotFinite(c) => write!(f, "`{c}` is not a finite number"),
             CellError::Empty => f.write_str("empty cell"),
             CellError::NotANumber(c) => write!(f, "cannot read `{c}` as a number"),
+            CellError::OutOfRange(c, what) => write!(f, "`{c}` is outside {what}"),
         }
     }
 }
 
-/// A cell as a finite number.
-fn number(cell: &str) -> Result<f64, CellError<'_>> {
+/// A cell as a finite number, within `range` where the column has one.
+fn number<'a>(
+    cell: &'a str,
+    range: Option<(f64, f64, &'static str)>,
+) -> Result<f64, CellError<'a>> {
     match cell.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_finite() => match range {
+            Some((lo, hi, what)) if !(lo..=hi).contains(&v) => {
+                Err(CellError::OutOfRange(cell, what))
+            }
+            _ => Ok(v),
+        },
         Ok(_) => Err(CellError::NotFinite(cell)),
         Err(_) if cell.is_empty() => Err(CellError::Empty),
         Err(_) => Err(CellError::NotANumber(cell)),
     }
+}
+
+/// A row whose cell count differs from the header's, at its line and the
+/// first cell too many (or the first missing).
+fn width_error(path: &Path, line: u64, cells: usize, header: usize) -> LabError {
+    LabError::at(
+        path,
+        line,
+        ColumnRef {
+            index: cells.min(header) + 1,
+            name: None,
+        },
+        format!(
+            "{cells} cells where the header has {header}: a cell {} shifts the columns after it",
+            if cells > header {
+                "too many"
+            } else {
+                "missing"
+            }
+        ),
+    )
+}
+
+/// Comment and blank lines before the header: their count and byte length.
+fn leading_comments(text: &[u8]) -> (u64, usize) {
+    let (mut lines, mut offset) = (0u64, 0usize);
+    for line in text.split_inclusive(|&b| b == b'\n') {
+        let t = line.trim_ascii();
+        if t.starts_with(b"#") || t.is_empty() {
+            lines += 1;
+            offset += line.len();
+        } else {
+            break;
+        }
+    }
+    (lines, offset)
 }
 
 fn column_ref(field: usize, name: &str) -> ColumnRef {
@@ -52,25 +106,21 @@ pub struct TextTable {
     pub header: Vec<String>,
     header_line: u64,
     rows: Vec<(u64, Vec<String>)>,
+    bounds: Option<Bounds>,
 }
 
 impl TextTable {
     pub fn read(path: &Path) -> Result<Self, LabError> {
+        Self::read_bounded(path, None)
+    }
+
+    /// Reads, checking every numeric column's cells against `bounds`.
+    pub fn read_bounded(path: &Path, bounds: Option<Bounds>) -> Result<Self, LabError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
         // Comment lines before the header are skipped by hand so that line
         // numbers stay those of the file.
-        let mut skipped = 0u64;
-        let mut offset = 0usize;
-        for line in text.split_inclusive('\n') {
-            let t = line.trim();
-            if t.starts_with('#') || t.is_empty() {
-                skipped += 1;
-                offset += line.len();
-            } else {
-                break;
-            }
-        }
+        let (skipped, offset) = leading_comments(text.as_bytes());
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -93,6 +143,9 @@ impl TextTable {
             if rec.iter().all(str::is_empty) {
                 continue;
             }
+            if rec.len() != header.len() {
+                return Err(width_error(path, line, rec.len(), header.len()));
+            }
             rows.push((line, rec.iter().map(str::to_owned).collect()));
         }
         Ok(Self {
@@ -100,6 +153,7 @@ impl TextTable {
             header,
             header_line,
             rows,
+            bounds,
         })
     }
 
@@ -138,11 +192,12 @@ impl TextTable {
     /// A numeric column: every cell a finite number.
     pub fn column(&self, col: &str) -> Result<Vec<f64>, LabError> {
         let i = self.index(col)?;
+        let range = self.bounds.and_then(|b| b(col));
         self.rows
             .iter()
             .map(|(line, cells)| {
                 let cell = cells.get(i).map(String::as_str).unwrap_or("");
-                number(cell).map_err(|m| {
+                number(cell, range).map_err(|m| {
                     LabError::at(&self.path, *line, column_ref(i + 1, col), m.to_string())
                 })
             })
@@ -216,6 +271,25 @@ pub struct ColumnStream {
     pub fields: Vec<usize>,
 }
 
+/// Consumes the comment and blank lines before the header; returns their
+/// count.
+fn skip_leading_comments(r: &mut impl std::io::BufRead) -> std::io::Result<u64> {
+    let mut n = 0;
+    loop {
+        let buf = r.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(n);
+        }
+        let first = buf.iter().find(|b| !matches!(b, b' ' | b'\t' | b'\r'));
+        if first.is_some_and(|&b| b != b'#' && b != b'\n') {
+            return Ok(n);
+        }
+        let mut line = Vec::new();
+        r.read_until(b'\n', &mut line)?;
+        n += 1;
+    }
+}
+
 impl ColumnStream {
     pub fn read(path: &Path, cols: &[&str]) -> Result<Self, LabError> {
         Self::read_with(path, cols, &[]).map(|(c, _)| c)
@@ -229,23 +303,40 @@ impl ColumnStream {
         required: &[&str],
         optional: &[&str],
     ) -> Result<(Self, Vec<Option<usize>>), LabError> {
-        let file = std::fs::File::open(path)
+        Self::read_bounded(path, required, optional, None)
+    }
+
+    /// [`Self::read_with`], every cell checked against `bounds`.
+    pub fn read_bounded(
+        path: &Path,
+        required: &[&str],
+        optional: &[&str],
+        bounds: Option<Bounds>,
+    ) -> Result<(Self, Vec<Option<usize>>), LabError> {
+        let mut file = std::io::BufReader::with_capacity(
+            1 << 20,
+            std::fs::File::open(path)
+                .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?,
+        );
+        // The comment lines before the header are skipped by hand, so the
+        // reader's line numbers are the file's plus their count (its own
+        // comment skipping does not count them).
+        let skipped = skip_leading_comments(&mut file)
             .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
-            .comment(Some(b'#'))
             .buffer_capacity(1 << 20)
-            .from_reader(std::io::BufReader::with_capacity(1 << 20, file));
+            .from_reader(file);
         let mut rec = csv::ByteRecord::new();
         let at = |e: csv::Error| {
-            let line = e.position().map_or(0, |p| p.line());
+            let line = e.position().map_or(0, |p| p.line()) + skipped;
             LabError::at_line(path, line, e.to_string())
         };
         if !rdr.read_byte_record(&mut rec).map_err(at)? {
             return Err(LabError::input(path, "no header row"));
         }
-        let header_line = rec.position().map_or(1, |p| p.line());
+        let header_line = rec.position().map_or(1, |p| p.line()) + skipped;
         let header: Vec<String> = rec
             .iter()
             .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
@@ -269,19 +360,23 @@ impl ColumnStream {
                 None => present.push(None),
             }
         }
+        let ranges: Vec<_> = cols.iter().map(|c| bounds.and_then(|b| b(c))).collect();
         let mut data: Vec<Vec<f64>> = cols.iter().map(|_| Vec::new()).collect();
         let mut lines = Vec::new();
         while rdr.read_byte_record(&mut rec).map_err(at)? {
-            let line = rec.position().map_or(0, |p| p.line());
+            let line = rec.position().map_or(0, |p| p.line()) + skipped;
             // Cells are trimmed here, only those read: the reader's own
             // trimming of every field cost a third of a long record's read.
             if rec.iter().all(|f| f.trim_ascii().is_empty()) {
                 continue;
             }
+            if rec.len() != header.len() {
+                return Err(width_error(path, line, rec.len(), header.len()));
+            }
             for (k, &f) in fields.iter().enumerate() {
                 let cell = rec.get(f - 1).unwrap_or(b"").trim_ascii();
                 let text = std::str::from_utf8(cell).unwrap_or("");
-                let v = number(text)
+                let v = number(text, ranges[k])
                     .map_err(|m| LabError::at(path, line, column_ref(f, cols[k]), m.to_string()))?;
                 data[k].push(v);
             }

@@ -11,3 +11,4 @@ pub mod gyro_kind;
 pub mod gyro_model;
 pub mod inputs;
 pub mod ranges;
+pub mod term;

@@ -19,8 +19,13 @@ pub struct Filled {
     pub values: Vec<f64>,
     /// The sample period (s): the median interval.
     pub tau0: f64,
-    /// Intervals longer than the sample period.
+    /// Intervals where at least one sample is missing (half a period or
+    /// more beyond the sample period): frames lost on the way.
     pub gaps: usize,
+    /// Intervals longer than the sample period by less than half of one: a
+    /// frame that spans closures the board missed (flagged in its frames),
+    /// no sample lost.
+    pub stretched: usize,
     /// Samples the uniform grid has beyond the record's rows.
     pub filled: usize,
 }
@@ -47,6 +52,7 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
         values: values[..n].to_vec(),
         tau0,
         gaps: 0,
+        stretched: 0,
         filled: 0,
     };
     if n < 2 {
@@ -60,7 +66,7 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
         return Err(SamplingError::NotIncreasing);
     }
     let tol = SAMPLING_TOLERANCE * med;
-    let mut gaps = 0;
+    let (mut gaps, mut stretched) = (0, 0);
     for (k, &h) in d.iter().enumerate() {
         if (h - med).abs() <= tol {
             continue;
@@ -75,9 +81,13 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
                 median: med,
             });
         }
-        gaps += 1;
+        if h >= 1.5 * med {
+            gaps += 1;
+        } else {
+            stretched += 1;
+        }
     }
-    if gaps == 0 {
+    if gaps + stretched == 0 {
         return Ok(uniform(med));
     }
     // The angle at each row's time (rate held over the interval before it),
@@ -106,6 +116,7 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
         values: out,
         tau0: med,
         gaps,
+        stretched,
         filled,
     })
 }
@@ -143,7 +154,7 @@ mod tests {
         }
         let f = fill_gaps(&t, &y).unwrap();
         assert_eq!(f.values.len(), 30);
-        assert_eq!((f.gaps, f.filled), (1, 3));
+        assert_eq!((f.gaps, f.stretched, f.filled), (1, 0, 3));
         let angle: f64 = f.values.iter().sum();
         let truth: f64 = rate.iter().sum();
         assert!((angle - truth).abs() < 1e-12, "{angle} vs {truth}");
@@ -172,7 +183,7 @@ mod tests {
             .collect();
         let y: Vec<f64> = (0..20).map(|i| 1.0 + 0.5 * (i % 3) as f64).collect();
         let f = fill_gaps(&t, &y).unwrap();
-        assert_eq!((f.gaps, f.filled), (1, 0));
+        assert_eq!((f.gaps, f.stretched, f.filled), (0, 1, 0));
         assert_eq!(f.values.len(), 20);
         let angle: f64 = f.values[1..].iter().sum();
         let truth: f64 = (1..20).map(|i| y[i] * (t[i] - t[i - 1])).sum::<f64>() - y[19] * 0.08;

@@ -4,7 +4,8 @@
 //! freedom (edf.rs), the IEEE 952 terms (terms.rs) fitted to the curve
 //! (fit.rs, nnls.rs, model.rs), records with lost samples made uniform
 //! (gaps.rs), the fit's goodness and honest intervals
-//! (uncertainty.rs), and the conventional readings (readings.rs).
+//! (uncertainty.rs), the conventional readings (readings.rs), and what the
+//! record must be for all that to mean something (record_checks.rs).
 
 pub mod adev;
 pub mod analysis;
@@ -15,5 +16,6 @@ pub mod model;
 pub mod nnls;
 pub mod profile;
 pub mod readings;
+pub mod record_checks;
 pub mod terms;
 pub mod uncertainty;

@@ -6,12 +6,18 @@
 
 use crate::noise::analysis::analyse;
 use gyro_sim::{FogRig, OpticsParams, Profile, Segment};
+use gyro_sp::fog::agc::DC_FILTER_CLOSURES;
 use gyro_sp::fog::{FogConfig, FogParams};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 const DPH_PER_RAD_S: f64 = 3600.0 / DEG;
 /// Closures per run-file row (a frame's worth).
 const ROW_CLOSURES: u32 = 25;
+/// The start-up left out of the mean by default, in time constants of the
+/// AGC's DC filter: its start from the first closure's DC decays as
+/// exp(-t/tau), and under 50 000 deg/s^2 at 60 Hz it starts at about 10 %
+/// of the eps^2 drift; five time constants leave 0.07 % of that.
+pub const SETTLE_TAUS: f64 = 5.0;
 
 /// A sinusoidal angular oscillation about the constant rate.
 #[derive(Clone, Debug)]
@@ -44,8 +50,9 @@ pub struct FogRunParams {
     pub vpi_error: f64,
     pub adc_bits: u32,
     pub dither_codes: f64,
-    /// Start-up time left out of the mean error, s.
-    pub settle_s: f64,
+    /// Start-up time left out of the mean error, s (None: [`SETTLE_TAUS`]
+    /// time constants of the AGC's DC filter, the slowest loop).
+    pub settle_s: Option<f64>,
     /// DAC latency, closures (0 or 1: the hw board's DMA ping-pong).
     pub dac_latency: u32,
 }
@@ -88,6 +95,11 @@ pub struct FogSummary {
     pub predicted_drift_dph: f64,
     pub duration_s: f64,
     pub averaged_s: f64,
+    /// Start-up left out of the mean, s.
+    pub settle_s: f64,
+    /// The whole settling time was left out (false: the run was too short,
+    /// half of it was, and the mean still holds some of the start-up).
+    pub settled: bool,
     pub steps: u64,
     pub wall_s: f64,
     pub realtime_factor: f64,
@@ -146,6 +158,7 @@ pub struct FogRun {
     steps: u64,
     avg_steps: u64,
     batch_steps: u64,
+    settled: bool,
 }
 
 /// The input-rate profile of a run: constant, or the oscillation in equal
@@ -239,8 +252,15 @@ impl FogRun {
         let predicted_dph = cfg.predicted_vibration_drift(mean_eps_sq) * DPH_PER_RAD_S;
         let dt = cfg.closure_period_s();
         let steps = (p.duration_s / dt).round() as u64;
-        // Average over whole oscillation periods after the settling time.
-        let settle_steps = ((p.settle_s / dt).ceil() as u64).min(steps / 2);
+        // Average over whole oscillation periods after the settling time;
+        // at most half the run is left out, and a run too short for the
+        // whole settling says so (`settled`).
+        let settle_s = p
+            .settle_s
+            .unwrap_or(SETTLE_TAUS * DC_FILTER_CLOSURES as f64 * dt);
+        let want_steps = (settle_s / dt).ceil() as u64;
+        let settle_steps = want_steps.min(steps / 2);
+        let settled = settle_steps == want_steps;
         let avg_steps = match period {
             Some(per) => {
                 let per = per / dt;
@@ -267,6 +287,7 @@ impl FogRun {
             steps,
             avg_steps,
             batch_steps,
+            settled,
         })
     }
 
@@ -350,6 +371,8 @@ impl FogRun {
             predicted_drift_dph: self.predicted_dph,
             duration_s: steps as f64 * dt,
             averaged_s: avg_steps as f64 * dt,
+            settle_s: (steps - avg_steps) as f64 * dt,
+            settled: self.settled,
             steps,
             wall_s: wall,
             realtime_factor: steps as f64 * dt / wall.max(1e-9),

@@ -7,6 +7,7 @@ use super::fit::{coefficient_se, fit_thermal, CubicModel, ThermalData};
 use super::warnings;
 use crate::calibration::scale_factor::validation::{flag_spans, FlagSpan};
 use crate::calibration::warning::Warning;
+use gyro_coeffs::rlg_thermal::COEFF_LIMIT;
 use gyro_sp::rlg::{CoeffError, ThermalCoeffs};
 
 /// The averaging of the drift figures, s.
@@ -44,21 +45,59 @@ pub struct FitSummary {
 #[derive(Debug)]
 pub enum ThermalFitError {
     Singular,
+    /// The run is too short for the model's time terms (the warm-up's
+    /// time constants start at 30 s): its length and the temperature spans
+    /// it saw.
+    TooShort {
+        duration_s: f64,
+        span_mono_c: f64,
+        span_case_c: f64,
+    },
     OutOfRange(CoeffError, ThermalCoeffs),
     Cubic,
 }
 
+/// What a user can do about a run that does not determine the model.
+const WHAT_TO_DO: &str = "fit on a chamber run that sweeps the temperature over \
+                          hours and tens of degC (e.g. `gyro-lab simulate chamber --profile cycle`)";
+
+/// The shortest run a fit is tried on: twenty times the shortest warm-up
+/// time constant searched. (A long run at one temperature is fitted, and
+/// its report says which terms it could not resolve.)
+const MIN_DURATION_S: f64 = 600.0;
+
 impl std::fmt::Display for ThermalFitError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ThermalFitError::Singular => {
-                f.write_str("the thermal model could not be fitted (singular data)")
-            }
-            ThermalFitError::OutOfRange(e, c) => write!(
+            ThermalFitError::Singular => write!(
                 f,
-                "fitted coefficients out of the firmware's range ({e:?}): {c:?}"
+                "the thermal model could not be fitted: its terms are collinear on this run; {WHAT_TO_DO}"
             ),
-            ThermalFitError::Cubic => f.write_str("cubic fit failed"),
+            ThermalFitError::TooShort {
+                duration_s,
+                span_mono_c,
+                span_case_c,
+            } => write!(
+                f,
+                "too short to fit: {duration_s:.1} s (at least {MIN_DURATION_S:.0} s), with the \
+                 monoblock over {span_mono_c:.2} degC and the case over {span_case_c:.2} degC; {WHAT_TO_DO}"
+            ),
+            ThermalFitError::OutOfRange(_, c) => {
+                let names = ThermalCoeffs::NAMES;
+                let v = c.values();
+                let worst = (0..6)
+                    .max_by(|&i, &j| v[i].abs().total_cmp(&v[j].abs()))
+                    .unwrap_or(0);
+                write!(
+                    f,
+                    "the fitted coefficients are outside what the firmware holds ({} = {:.3e}, \
+                     limit +-{COEFF_LIMIT:.0e}): this run does not determine the thermal model; {WHAT_TO_DO}",
+                    names[worst], v[worst]
+                )
+            }
+            ThermalFitError::Cubic => {
+                write!(f, "the classic cubic could not be fitted on this run; {WHAT_TO_DO}")
+            }
         }
     }
 }
@@ -83,6 +122,19 @@ pub fn cubic_residual(m: &CubicModel, d: &ThermalData) -> Vec<f64> {
 /// The improved model fitted on a chamber run, checked against the
 /// firmware's ranges, next to the classic cubic.
 pub fn calibrate(d: &ThermalData) -> Result<FitSummary, ThermalFitError> {
+    let span = |v: &[f64]| {
+        let [lo, hi] = range(v);
+        hi - lo
+    };
+    let duration_s = d.t.last().copied().unwrap_or(0.0) - d.t.first().copied().unwrap_or(0.0);
+    let (span_mono_c, span_case_c) = (span(&d.a).max(span(&d.b)), span(&d.case));
+    if duration_s < MIN_DURATION_S {
+        return Err(ThermalFitError::TooShort {
+            duration_s,
+            span_mono_c,
+            span_case_c,
+        });
+    }
     let (c, resid) = fit_thermal(d).ok_or(ThermalFitError::Singular)?;
     c.check().map_err(|e| ThermalFitError::OutOfRange(e, c))?;
     let cubic = CubicModel::fit(&d.a, &d.drift_dph).ok_or(ThermalFitError::Cubic)?;

@@ -40,6 +40,7 @@ impl From<GyroArg> for GyroKind {
 
 #[derive(Args, Debug, Clone)]
 pub struct DiscoverArgs {
+    /// The gyro the run is from: its kind sets the ideal model and the library of effects.
     #[arg(long, value_enum)]
     pub gyro: GyroArg,
     /// The model (model.toml); the ideal gyro without it.

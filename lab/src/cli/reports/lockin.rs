@@ -186,7 +186,7 @@ fn bound_plot(rep: &mut Report, r: &LockIn) {
             ),
             Series::points("this estimate (fit covariance)", est, None, 0),
         ],
-        "The information limit sigma/(sqrt(N) A rho) (physics.md 2.1; the small-lock-in form, exact for \
+        "The information limit sigma/(sqrt(N) A rho) (docs/lockin.md, the information limit; the small-lock-in form, exact for \
          Omega_I/Omega_L >= 10; sqrt(2) more from one photodiode) for a record like this one at other rate \
          ratios, and where this estimate stands: an estimate on the line extracts all the record holds.",
     );

@@ -16,14 +16,15 @@ use std::path::Path;
 /// At most this many points per plotted series.
 pub const MAX_POINTS: usize = 2000;
 
-/// `report.html` beside `out` (a file the command writes).
+/// The report of a command whose output is the file `out`: beside it and
+/// named after it (`coeffs.toml` -> `coeffs.html`, `val_comp.csv` ->
+/// `val_comp.html`), so calibrations written into one folder keep their
+/// reports. An output already named `.html` gets `.report.html`.
 pub fn beside(out: &Path) -> std::path::PathBuf {
-    out.parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .map_or_else(
-            || Path::new("report.html").to_owned(),
-            |p| p.join("report.html"),
-        )
+    if out.extension().is_some_and(|e| e == "html") {
+        return out.with_extension("report.html");
+    }
+    out.with_extension("html")
 }
 
 /// How a figure compares with its noise floor, in words.

@@ -252,7 +252,9 @@ fn criterion_tables(r: &mut Report, f: &SfFit) {
         .iter()
         .map(|&deg| {
             let mut row = vec![match deg {
-                1 => "straight line (degree 1)".to_owned(),
+                // The knees family: lines, no polynomial (degree 0, as the
+                // JSON and the verdict state it).
+                1 => "straight lines: the knees family (degree 0)".to_owned(),
                 d => format!("polynomial, degree {d}"),
             }];
             for k in 0..=max_k {
@@ -294,7 +296,7 @@ fn criterion_tables(r: &mut Report, f: &SfFit) {
     r.note(
         "BIC = n ln(SSE/n)/phi + p ln(n) over the 10 s bins (p: the linear coefficients, the knee \
          temperatures), phi the residual's correlation inflation. A difference above 10 is decisive; \
-         the knees family is piecewise linear (degree 0 in the JSON).",
+         the knees family is piecewise linear: no polynomial, degree 0 in the JSON and above.",
     );
 }
 

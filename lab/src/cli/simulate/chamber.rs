@@ -31,6 +31,7 @@ impl From<ChamberProfileArg> for ChamberProfile {
 
 #[derive(Args, Debug, Clone)]
 pub struct ChamberArgs {
+    /// Chamber temperature profile.
     #[arg(long, value_enum, default_value_t = ChamberProfileArg::Cycle)]
     pub profile: ChamberProfileArg,
     /// Chamber temperature of the `soak` profile, degC.
@@ -48,6 +49,7 @@ pub struct ChamberArgs {
     /// Sensitive axis elevation, deg (90: axis up).
     #[arg(long, default_value_t = 90.0, allow_negative_numbers = true)]
     pub elevation_deg: f64,
+    /// Latitude, deg (the Earth rate's vertical component).
     #[arg(long, default_value_t = 48.0, allow_negative_numbers = true)]
     pub latitude_deg: f64,
     #[command(flatten)]

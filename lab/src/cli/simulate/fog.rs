@@ -35,8 +35,9 @@ pub struct FogArgs {
     /// most 8. Default: the full level throughout.
     #[arg(long, value_delimiter = ',', requires = "vibration_dps2")]
     pub vibration_levels: Vec<f64>,
-    /// Simulated time, s.
-    #[arg(long, default_value_t = 1.0)]
+    /// Simulated time, s (the mean error is taken after the start-up, see
+    /// --settle-s).
+    #[arg(long, default_value_t = 4.0)]
     pub duration_s: f64,
     /// Turn the online epsilon-squared correction off.
     #[arg(long)]
@@ -65,9 +66,11 @@ pub struct FogArgs {
     /// Modulation-depth dither, half width in ADC codes of the detector level (0 = off).
     #[arg(long, default_value_t = 60.0)]
     pub dither_codes: f64,
-    /// Start-up time left out of the mean error, s.
-    #[arg(long, default_value_t = 0.02)]
-    pub settle_s: f64,
+    /// Start-up time left out of the mean error, s (default: five time
+    /// constants of the AGC's DC filter, 1.64 s at 12.5 kHz; at most half
+    /// the run).
+    #[arg(long)]
+    pub settle_s: Option<f64>,
     /// DAC latency, closures: 1 simulates the hw board's DMA ping-pong (the
     /// words computed in one closure drive the modulator in the next), as
     /// the rig does; 0 (QEMU, the host rigs) applies them at once.
@@ -162,6 +165,14 @@ pub fn run(a: &FogArgs) -> Result<(), LabError> {
     if let Some(w) = writer {
         w.finish()?;
     }
+    if !s.settled {
+        eprintln!(
+            "warning: --duration-s {} is too short to leave out the whole start-up: the mean is taken \
+             after {:.3} s and still holds some of the loops' settling (give --duration-s of at least \
+             twice the settling time, or --settle-s)",
+            a.duration_s, s.settle_s
+        );
+    }
     if a.json.json {
         return print_json(&s);
     }
@@ -170,7 +181,10 @@ pub fn run(a: &FogArgs) -> Result<(), LabError> {
         None => format!("{v:+.6} (standard error unknown: under 2 batches)"),
     };
     println!(
-        "mean error: {} deg/h corrected, {} deg/h raw (formula drift {:+.6} deg/h)",
+        "mean error over {:.3} s after a start-up of {:.3} s: {} deg/h corrected, {} deg/h raw \
+         (formula drift {:+.6} deg/h)",
+        s.averaged_s,
+        s.settle_s,
         pm(s.mean_error_dph, s.mean_error_stderr_dph),
         pm(s.mean_error_raw_dph, s.mean_error_raw_stderr_dph),
         s.predicted_drift_dph
@@ -180,7 +194,11 @@ pub fn run(a: &FogArgs) -> Result<(), LabError> {
         ("raw", s.mean_error_raw_dph, s.mean_error_raw_stderr_dph),
     ] {
         if let Some(se) = se {
-            if se > 0.1 * v.abs() && v != 0.0 {
+            if v.abs() < 2.0 * se {
+                println!(
+                    "note: the {what} mean is consistent with zero (within two standard errors)"
+                );
+            } else if se > 0.1 * v.abs() {
                 // The standard error falls as 1/sqrt(T).
                 let need = s.averaged_s * (se / (0.1 * v.abs())).powi(2);
                 println!(

@@ -16,10 +16,13 @@ pub struct LockinSimArgs {
     /// Lock-in rate Omega_L, deg/s.
     #[arg(long, default_value_t = 0.1)]
     pub lock_in_dps: f64,
+    /// Scale factor K, pulses (fringes) per degree.
     #[arg(long, default_value_t = 2000.0)]
     pub pulses_per_deg: f64,
+    /// Sampling rate of the photodiode record, Hz.
     #[arg(long, default_value_t = 20_000.0)]
     pub sample_hz: f64,
+    /// Record length, s.
     #[arg(long, default_value_t = 3.0)]
     pub duration_s: f64,
     /// Noise standard deviation relative to the fringe amplitude.
@@ -31,6 +34,7 @@ pub struct LockinSimArgs {
     /// Offset of the photodiode signal, in fringe amplitudes.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub offset: f64,
+    /// Phase beta of the lock-in term (backscatter phase), rad.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub beta_rad: f64,
     #[command(flatten)]

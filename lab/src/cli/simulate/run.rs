@@ -101,17 +101,21 @@ pub struct SimulateRunArgs {
     /// The truth: a model file (its gyro kind must match the profile's).
     #[arg(long)]
     pub model: PathBuf,
+    /// The test profile the model is run on (each sets the gyro kind, the row period and
+    /// the length).
     #[arg(long, value_enum)]
     pub profile: TestProfileArg,
-    /// Row period and duration, s (default: the profile's).
+    /// Row period, s (default: the profile's).
     #[arg(long)]
     pub dt_s: Option<f64>,
+    /// Record length, s (default: the profile's).
     #[arg(long)]
     pub duration_s: Option<f64>,
-    /// Angle random walk, deg/sqrt(h), and bias instability, deg/h
-    /// (default: a navigation-grade gyro of the profile's kind).
+    /// Angle random walk, deg/sqrt(h) (default: a navigation-grade gyro of
+    /// the profile's kind).
     #[arg(long)]
     pub arw_dpsh: Option<f64>,
+    /// Bias instability, deg/h (default: a navigation-grade gyro of the profile's kind).
     #[arg(long)]
     pub bias_instability_dph: Option<f64>,
     /// Rate random walk, deg/h/sqrt(h) (default none).

@@ -60,6 +60,8 @@ pub enum TestKind {
 
 #[derive(Args, Debug, Clone)]
 pub struct SimulateArgs {
+    /// The calibration test: continuous rotation through the chamber sweep, or the classic
+    /// multi-point plateaus.
     #[arg(long, value_enum, default_value_t = TestKind::Continuous)]
     pub test: TestKind,
     /// Chamber profile of the continuous test.
@@ -68,6 +70,7 @@ pub struct SimulateArgs {
     /// Table rate of the continuous test, deg/s (50 or more).
     #[arg(long, default_value_t = 50.0)]
     pub rate_dps: f64,
+    /// Table direction of the continuous test: positive, negative, or both (alternating).
     #[arg(long, value_enum, default_value_t = DirectionArg::Both)]
     pub direction: DirectionArg,
     /// With `--direction both`: reverse every this many seconds.
@@ -79,9 +82,10 @@ pub struct SimulateArgs {
     /// Rate magnitudes of each plateau's sequence (each both ways), deg/s.
     #[arg(long, value_delimiter = ',', default_values_t = [10.0, 20.0, 50.0, 100.0, 200.0])]
     pub rates_dps: Vec<f64>,
-    /// Soak at rest before each plateau's sequence, s; dwell per rate, s.
+    /// Soak at rest before each plateau's sequence, s.
     #[arg(long, default_value_t = 3600.0)]
     pub soak_s: f64,
+    /// Dwell at each rate of a multi-point plateau, s.
     #[arg(long, default_value_t = 60.0)]
     pub dwell_s: f64,
     /// The same gyro without its knee.
@@ -96,19 +100,23 @@ pub struct SimulateArgs {
         conflicts_with = "no_knee"
     )]
     pub knees_c: Vec<f64>,
+    /// Slope change at each of `--knees-c`, ppm/degC (one per knee).
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     pub knee_slope_changes: Vec<f64>,
     /// Smooth curvature of the truth: `q (T - centre)^2 + c (T - centre)^3`
-    /// added to the scale-factor error, ppm/degC^2 and ppm/degC^3.
+    /// added to the scale-factor error; this is q, ppm/degC^2.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub quadratic_ppm_per_c2: f64,
+    /// Cubic term of the scale-factor error about `--curve-centre-c`, ppm/degC^3.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub cubic_ppm_per_c3: f64,
+    /// Temperature the quadratic and cubic terms are centred on, degC.
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub curve_centre_c: f64,
-    /// Angle random walk, deg/sqrt(h); bias instability, deg/h.
+    /// Angle random walk of the gyro noise, deg/sqrt(h).
     #[arg(long, default_value_t = 0.005)]
     pub arw_dpsh: f64,
+    /// Bias instability of the gyro noise, deg/h.
     #[arg(long, default_value_t = 0.01)]
     pub bias_instability_dph: f64,
     /// Coil sensor lag behind the coil, s.

@@ -1,0 +1,327 @@
+//! A formula evaluated on a run, row by row: its columns by name, the
+//! term's parameters, `pi`; `ddt` and `d2dt2` are the tool's own filtered
+//! derivatives in time (below), the same wherever a term is evaluated
+//! (`simulate run --model`, `discover --model`, `discover`'s own fit).
+//! A division by zero or a value that is not finite anywhere on the run
+//! is an error at the place in the formula that made it.
+
+use super::parse::{Expr, Func, Node, Op};
+use crate::data::run_file::Column;
+use crate::model::discovery::terms::curvature;
+use crate::model::inputs::centered_slope;
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// `ddt(x)`: the least-squares slope of x over this many seconds either
+/// side of each row (fewer at the record's ends): long enough to average a
+/// quantised sensor's steps, short against thermal time constants.
+pub const DDT_HALF_WIDTH_S: f64 = 30.0;
+/// `d2dt2(x)`: the slope of that slope, each over this many seconds either
+/// side, and a local cubic's curvature near the record's ends.
+pub const D2DT2_HALF_WIDTH_S: f64 = 120.0;
+
+/// The columns a formula may name: the run's inputs. Not the output
+/// (`rate_dps`, the angle): a model predicts those.
+pub const INPUT_COLUMNS: [Column; 7] = [
+    Column::Time,
+    Column::RefRate,
+    Column::Temp,
+    Column::MonoA,
+    Column::MonoB,
+    Column::Case,
+    Column::RefAcc,
+];
+
+/// What a formula is evaluated with.
+pub struct Env<'a> {
+    /// The run's input columns present, by name (time among them).
+    pub columns: &'a BTreeMap<&'a str, &'a [f64]>,
+    /// The term's parameters.
+    pub params: &'a BTreeMap<String, f64>,
+}
+
+/// A formula that cannot be evaluated on this run: where in its text, and
+/// why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EvalError {
+    pub span: Range<usize>,
+    pub msg: String,
+}
+
+/// A value per row, or one for all rows.
+enum Val {
+    Row(Vec<f64>),
+    All(f64),
+}
+
+impl Val {
+    fn map(self, f: impl Fn(f64) -> f64) -> Val {
+        match self {
+            Val::All(a) => Val::All(f(a)),
+            Val::Row(v) => Val::Row(v.into_iter().map(f).collect()),
+        }
+    }
+
+    fn zip(self, o: Val, f: impl Fn(f64, f64) -> f64) -> Val {
+        match (self, o) {
+            (Val::All(a), Val::All(b)) => Val::All(f(a, b)),
+            (Val::Row(a), Val::All(b)) => Val::Row(a.into_iter().map(|x| f(x, b)).collect()),
+            (Val::All(a), Val::Row(b)) => Val::Row(b.into_iter().map(|y| f(a, y)).collect()),
+            (Val::Row(a), Val::Row(b)) => {
+                Val::Row(a.into_iter().zip(b).map(|(x, y)| f(x, y)).collect())
+            }
+        }
+    }
+
+    /// The first row (0 for a constant) where `bad` holds.
+    fn first(&self, bad: impl Fn(f64) -> bool) -> Option<usize> {
+        match self {
+            Val::All(a) => bad(*a).then_some(0),
+            Val::Row(v) => v.iter().position(|&x| bad(x)),
+        }
+    }
+}
+
+/// Names a formula uses, with the span of each use.
+pub fn names(n: &Node) -> Vec<(String, Range<usize>)> {
+    fn go(n: &Node, out: &mut Vec<(String, Range<usize>)>) {
+        match &n.expr {
+            Expr::Num(_) => {}
+            Expr::Name(s) => out.push((s.clone(), n.span.clone())),
+            Expr::Neg(x) | Expr::Call(_, x) => go(x, out),
+            Expr::Bin(_, l, r) => {
+                go(l, out);
+                go(r, out);
+            }
+        }
+    }
+    let mut v = vec![];
+    go(n, &mut v);
+    v
+}
+
+/// The formula's value on every row of a run of `rows` rows, deg/h.
+pub fn evaluate(n: &Node, env: &Env, rows: usize) -> Result<Vec<f64>, EvalError> {
+    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
+    let at = |k: usize| {
+        t.get(k).map_or(String::new(), |t| {
+            format!(" (at {} = {t})", Column::Time.name())
+        })
+    };
+    let v = eval(n, env, &at)?;
+    if let Some(k) = v.first(|x| !x.is_finite()) {
+        return Err(EvalError {
+            span: n.span.clone(),
+            msg: format!("the formula is not finite{}", at(k)),
+        });
+    }
+    Ok(match v {
+        Val::All(a) => vec![a; rows],
+        Val::Row(r) => r,
+    })
+}
+
+fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalError> {
+    let err = |msg: String| EvalError {
+        span: n.span.clone(),
+        msg,
+    };
+    Ok(match &n.expr {
+        Expr::Num(v) => Val::All(*v),
+        Expr::Name(s) => {
+            if let Some(c) = env.columns.get(s.as_str()) {
+                Val::Row(c.to_vec())
+            } else if let Some(p) = env.params.get(s) {
+                Val::All(*p)
+            } else if s == "pi" {
+                Val::All(std::f64::consts::PI)
+            } else {
+                return Err(err(unknown_name(s, env)));
+            }
+        }
+        Expr::Neg(x) => eval(x, env, at)?.map(|a| -a),
+        Expr::Bin(op, l, r) => {
+            let (a, b) = (eval(l, env, at)?, eval(r, env, at)?);
+            match op {
+                Op::Add => a.zip(b, |x, y| x + y),
+                Op::Sub => a.zip(b, |x, y| x - y),
+                Op::Mul => a.zip(b, |x, y| x * y),
+                Op::Div => {
+                    if let Some(k) = b.first(|y| y == 0.0) {
+                        return Err(EvalError {
+                            span: r.span.clone(),
+                            msg: format!("divides by zero{}", at(k)),
+                        });
+                    }
+                    a.zip(b, |x, y| x / y)
+                }
+                Op::Pow => {
+                    let v = a.zip(b, pow);
+                    if let Some(k) = v.first(|x| !x.is_finite()) {
+                        return Err(err(format!("a power that is not finite{}", at(k))));
+                    }
+                    v
+                }
+            }
+        }
+        Expr::Call(f, x) => {
+            let a = eval(x, env, at)?;
+            match f {
+                Func::Abs => a.map(f64::abs),
+                Func::Sin => a.map(f64::sin),
+                Func::Cos => a.map(f64::cos),
+                Func::Exp => {
+                    let v = a.map(f64::exp);
+                    if let Some(k) = v.first(|x| !x.is_finite()) {
+                        return Err(err(format!("exp overflows{}", at(k))));
+                    }
+                    v
+                }
+                Func::Step => a.map(|v| if v >= 0.0 { 1.0 } else { 0.0 }),
+                Func::Ddt | Func::D2dt2 => {
+                    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
+                    let row = match a {
+                        // The derivative of a constant.
+                        Val::All(_) => return Ok(Val::All(0.0)),
+                        Val::Row(r) => r,
+                    };
+                    Val::Row(if *f == Func::Ddt {
+                        centered_slope(t, &row, DDT_HALF_WIDTH_S)
+                    } else {
+                        curvature(t, &row, D2DT2_HALF_WIDTH_S)
+                    })
+                }
+            }
+        }
+    })
+}
+
+/// x^y, exact for small whole exponents (x^2 is x*x, as the formula says).
+fn pow(x: f64, y: f64) -> f64 {
+    if y.fract() == 0.0 && y.abs() <= 16.0 {
+        x.powi(y as i32)
+    } else {
+        x.powf(y)
+    }
+}
+
+fn unknown_name(s: &str, env: &Env) -> String {
+    let cols: Vec<&str> = env.columns.keys().copied().collect();
+    let params: Vec<&str> = env.params.keys().map(String::as_str).collect();
+    let why = if INPUT_COLUMNS.iter().any(|c| c.name() == s) {
+        format!("the run has no column `{s}`")
+    } else if s == Column::Rate.name() || s == Column::Angle.name() {
+        format!("`{s}` is the gyro's output, which the model predicts: a term is built from the run's inputs")
+    } else {
+        format!("unknown name `{s}`")
+    };
+    format!(
+        "{why} (the run's inputs: {}; the term's parameters: {}; and pi)",
+        cols.join(", "),
+        if params.is_empty() {
+            "none".to_string()
+        } else {
+            params.join(", ")
+        }
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::parse::parse;
+    use super::*;
+
+    /// The formula with the columns' names put in: `{t}` time, `{w}` the
+    /// reference rate, `{T}` the coil temperature, `{y}` the output.
+    fn f(s: &str) -> String {
+        s.replace("{t}", Column::Time.name())
+            .replace("{w}", Column::RefRate.name())
+            .replace("{T}", Column::Temp.name())
+            .replace("{y}", Column::Rate.name())
+    }
+
+    fn run(
+        formula: &str,
+        cols: &[(Column, Vec<f64>)],
+        params: &[(&str, f64)],
+    ) -> Result<Vec<f64>, EvalError> {
+        let n = parse(&f(formula)).unwrap();
+        let owned: BTreeMap<&str, &[f64]> =
+            cols.iter().map(|(k, v)| (k.name(), v.as_slice())).collect();
+        let p: BTreeMap<String, f64> = params.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        let rows = cols.first().map_or(1, |c| c.1.len());
+        evaluate(
+            &n,
+            &Env {
+                columns: &owned,
+                params: &p,
+            },
+            rows,
+        )
+    }
+
+    #[test]
+    fn values_as_the_formula_says() {
+        let t: Vec<f64> = (0..5).map(|k| k as f64).collect();
+        let w = vec![-2.0, -1.0, 0.0, 1.0, 2.0];
+        let y = run(
+            "k_dph * {w}^2 + c * abs({w}) * step({t} - 2)",
+            &[(Column::Time, t.clone()), (Column::RefRate, w.clone())],
+            &[("k_dph", 0.5), ("c", 3.0)],
+        )
+        .unwrap();
+        assert_eq!(y, vec![2.0, 0.5, 0.0, 3.5, 8.0]);
+        let y = run("2^3^2 - -1 + pi * 0", &[(Column::Time, t.clone())], &[]).unwrap();
+        assert_eq!(y, vec![513.0; 5]);
+        // ddt of a line is its slope; d2dt2 of a parabola its curvature.
+        let t: Vec<f64> = (0..2000).map(|k| k as f64).collect();
+        let x: Vec<f64> = t.iter().map(|t| 3.0 + 0.01 * t + 1e-6 * t * t).collect();
+        let d = run(
+            "ddt({T})",
+            &[(Column::Time, t.clone()), (Column::Temp, x.clone())],
+            &[],
+        )
+        .unwrap();
+        assert!(
+            (d[1000] - (0.01 + 2e-6 * 1000.0)).abs() < 1e-9,
+            "{}",
+            d[1000]
+        );
+        let c = run(
+            "d2dt2({T})",
+            &[(Column::Time, t.clone()), (Column::Temp, x)],
+            &[],
+        )
+        .unwrap();
+        assert!(c.iter().all(|c| (c - 2e-6).abs() < 1e-9), "{:?}", &c[..3]);
+    }
+
+    #[test]
+    fn errors_at_the_place_that_made_them() {
+        let t: Vec<f64> = (0..5).map(|k| k as f64).collect();
+        let e = run("k / ({t} - 2)", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
+        assert_eq!(e.span, 4..13);
+        assert!(
+            e.msg.contains(&f("divides by zero (at {t} = 2)")),
+            "{}",
+            e.msg
+        );
+        let e = run("k * {T}", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
+        assert_eq!(e.span, 4..10);
+        assert!(
+            e.msg.contains(&f("the run has no column `{T}`")),
+            "{}",
+            e.msg
+        );
+        let e = run("k * {y}", &[(Column::Time, t.clone())], &[("k", 1.0)]).unwrap_err();
+        assert!(e.msg.contains("the gyro's output"), "{}", e.msg);
+        let e = run("exp(1000 * {t})", &[(Column::Time, t.clone())], &[]).unwrap_err();
+        assert!(
+            e.msg.contains(&f("exp overflows (at {t} = 1)")),
+            "{}",
+            e.msg
+        );
+        let e = run("({t} - 3)^0.5", &[(Column::Time, t)], &[]).unwrap_err();
+        assert!(e.msg.contains(&f("not finite (at {t} = 0)")), "{}", e.msg);
+    }
+}
