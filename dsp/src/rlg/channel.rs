@@ -131,6 +131,13 @@ impl RlgChannel {
         }
     }
 
+    /// A pickoff crossing the latch hardware overwrote before it was read
+    /// (flagged; the stripping refuses or restarts on the next one).
+    #[inline(always)]
+    pub fn latch_lost(&mut self) {
+        self.strip.flag(StripFlags::LATCH_REFUSED);
+    }
+
     /// The update interrupt at latch-timer time `time`: one counter read; the
     /// output angle (stripped at the previous update's instant on a dithered
     /// gyro, the raw count at this one otherwise); on sensor ticks (`temps`)
