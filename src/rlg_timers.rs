@@ -39,12 +39,27 @@ pub fn configure_encoder(tim3: &pac::tim3::RegisterBlock) {
     tim3.cr1().modify(|_, w| w.cen().clear_bit());
     tim3.arr().write(|w| w.arr().set(0xFFFF));
     tim3.ccmr1_input().write(|w| {
-        w.cc1s().ti1().cc2s().ti2().ic1f().set(0b0011).ic2f().set(0b0011)
+        w.cc1s()
+            .ti1()
+            .cc2s()
+            .ti2()
+            .ic1f()
+            .set(0b0011)
+            .ic2f()
+            .set(0b0011)
     });
-    tim3.ccmr2_input().write(|w| w.cc3s().ti3().cc4s().ti3().ic3f().set(0b0011));
+    tim3.ccmr2_input()
+        .write(|w| w.cc3s().ti3().cc4s().ti3().ic3f().set(0b0011));
     // CC3: rising edges of TI3; CC4: falling (CC4P inverts TI3FP4).
     tim3.ccer().write(|w| {
-        w.cc3e().set_bit().cc3p().clear_bit().cc4e().set_bit().cc4p().set_bit()
+        w.cc3e()
+            .set_bit()
+            .cc3p()
+            .clear_bit()
+            .cc4e()
+            .set_bit()
+            .cc4p()
+            .set_bit()
     });
     tim3.smcr().modify(|_, w| w.sms().encoder_mode_3());
     tim3.sr().write(|w| unsafe { w.bits(0) });
@@ -59,8 +74,10 @@ pub fn configure_clock(tim5: &pac::tim5::RegisterBlock, period: u32) {
     tim5.psc().write(|w| w.psc().set(0));
     tim5.arr().write(|w| w.arr().set(u32::MAX));
     // CH1: frozen output compare (no pin); CH2: input capture of TI2.
-    tim5.ccmr1_input().write(|w| w.cc2s().ti2().ic2f().set(0b0011));
-    tim5.ccer().write(|w| w.cc2e().set_bit().cc2p().set_bit().cc2np().set_bit());
+    tim5.ccmr1_input()
+        .write(|w| w.cc2s().ti2().ic2f().set(0b0011));
+    tim5.ccer()
+        .write(|w| w.cc2e().set_bit().cc2p().set_bit().cc2np().set_bit());
     tim5.egr().write(|w| w.ug().set_bit());
     tim5.ccr1().write(|w| w.ccr().set(period));
     tim5.sr().write(|w| unsafe { w.bits(0) });
@@ -80,7 +97,7 @@ pub fn update_read(
     tim5.sr().write(|w| unsafe { w.bits(!(1 << 1)) });
     let next = tim5.ccr1().read().ccr().bits().wrapping_add(period);
     tim5.ccr1().write(|w| w.ccr().set(next));
-    let counter = tim3.cnt().read().cnt().bits() as u16;
+    let counter = tim3.cnt().read().cnt().bits();
     let time = tim5.cnt().read().cnt().bits();
     (time, counter)
 }
@@ -101,16 +118,17 @@ pub fn latch_read(
     let overrun4 = sr.cc4of().bit_is_set() || time_overrun;
     if overrun3 || overrun4 {
         // Overcapture flags are cleared by writing 0 (rc_w0).
-        tim3.sr().write(|w| unsafe { w.bits(!((1 << 11) | (1 << 12))) });
+        tim3.sr()
+            .write(|w| unsafe { w.bits(!((1 << 11) | (1 << 12))) });
         tim5.sr().write(|w| unsafe { w.bits(!(1 << 10)) });
     }
     let rise = sr.cc3if().bit_is_set().then(|| Latched {
-        counter: tim3.ccr3().read().ccr().bits() as u16,
+        counter: tim3.ccr3().read().ccr().bits(),
         rising: true,
         overrun: overrun3,
     });
     let fall = sr.cc4if().bit_is_set().then(|| Latched {
-        counter: tim3.ccr4().read().ccr().bits() as u16,
+        counter: tim3.ccr4().read().ccr().bits(),
         rising: false,
         overrun: overrun4,
     });

@@ -94,10 +94,16 @@ fn simulator_matches_brute_force() {
                 y.truth_counts
             );
         }
-        let (ka, kb) = (kicks(&a, rate, p.counts_per_deg), kicks(&b, rate, p.counts_per_deg));
+        let (ka, kb) = (
+            kicks(&a, rate, p.counts_per_deg),
+            kicks(&b, rate, p.counts_per_deg),
+        );
         let diff: Vec<f64> = ka.iter().zip(&kb).map(|(x, y)| x - y).collect();
         let ratio = rms(&diff) / rms(&kb);
-        assert!(ratio < tol, "{p:?}: per-crossing error {ratio:.2e} of the kick");
+        assert!(
+            ratio < tol,
+            "{p:?}: per-crossing error {ratio:.2e} of the kick"
+        );
     }
 }
 
@@ -122,7 +128,10 @@ fn fresnel_kick_and_killpatrick_walk() {
         let kfr = p.fringes_per_deg();
         let fresnel = p.lock_in_dps * (1.0 / (kfr * p.omega_dot())).sqrt() / 2f64.sqrt();
         // 30 s of kicks at 2 f_d: the rms to about 0.5 %.
-        assert!((kr / fresnel - 1.0).abs() < 0.02, "{p:?}: kick {kr:.4e} vs {fresnel:.4e}");
+        assert!(
+            (kr / fresnel - 1.0).abs() < 0.02,
+            "{p:?}: kick {kr:.4e} vs {fresnel:.4e}"
+        );
         // The walk over 0.1 s steps: 300 increments, N to about 4 %.
         let d: Vec<f64> = e.windows(2).map(|w| w[1] - w[0]).collect();
         let n = rms(&d) / 0.1f64.sqrt();
@@ -179,7 +188,11 @@ impl Rig {
 
     /// One frame; `board(latch, out)` puts what the latch interrupt sees
     /// of each zero crossing in `out` (nothing, it, or it and a glitch).
-    fn frame(&mut self, rate: f64, mut board: impl FnMut(&Latch, &mut Vec<LatchSample>)) -> FrameOut {
+    fn frame(
+        &mut self,
+        rate: f64,
+        mut board: impl FnMut(&Latch, &mut Vec<LatchSample>),
+    ) -> FrameOut {
         self.i += 1;
         let t = self.i as f64 / FRAME_HZ as f64;
         let ticks = |t: f64| ((t * CLOCK_HZ as f64).round() as u64) as u32;
@@ -255,7 +268,10 @@ fn stripping_residual_and_no_lost_count() {
             last = f.truth;
         }
         let r = rms_about_mean(&res);
-        assert!(r < bound, "photodiodes {photodiodes}: residual {r:.4} counts rms");
+        assert!(
+            r < bound,
+            "photodiodes {photodiodes}: residual {r:.4} counts rms"
+        );
         // The frames' whole counts against the gyro's angle over the same
         // span: the ends' residuals and the floors' fractions apart.
         let total = rig.frame_counts;
@@ -264,7 +280,10 @@ fn stripping_residual_and_no_lost_count() {
             (total as f64 - want).abs() < 2.0,
             "frames {total} counts, gyro {want:.3}"
         );
-        assert!(total.abs() > 1_000_000, "{total} counts: the counter wrapped");
+        assert!(
+            total.abs() > 1_000_000,
+            "{total} counts: the counter wrapped"
+        );
     }
 }
 
@@ -363,8 +382,14 @@ fn dead_band_gone() {
         .collect();
     let m = b.iter().sum::<f64>() / b.len() as f64;
     let se = rms_about_mean(&b) / (b.len() as f64 - 1.0).sqrt();
-    assert!(m.abs() < 3.0 * se, "mean error {m:.3e} deg/s, stderr {se:.3e}");
-    assert!(se < 0.01 * rate, "{se:.3e}: the test resolves the dead band");
+    assert!(
+        m.abs() < 3.0 * se,
+        "mean error {m:.3e} deg/s, stderr {se:.3e}"
+    );
+    assert!(
+        se < 0.01 * rate,
+        "{se:.3e}: the test resolves the dead band"
+    );
 }
 
 /// The CORDIC's phase against atan2 over the photodiodes' range.
@@ -384,4 +409,3 @@ fn cordic_phase() {
     }
     assert!(worst < 4e-5, "worst {worst:.2e} turn");
 }
-

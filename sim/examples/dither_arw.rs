@@ -2,7 +2,10 @@
 use gyro_sim::rlg_dither::{DitherParams, DitheredRlg};
 
 fn main() {
-    let a: Vec<f64> = std::env::args().skip(1).map(|a| a.parse().unwrap()).collect();
+    let a: Vec<f64> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().unwrap())
+        .collect();
     let p = DitherParams {
         counts_per_deg: a[0],
         lock_in_dps: a[1],
@@ -35,7 +38,11 @@ fn main() {
         let mean = d.iter().sum::<f64>() / d.len() as f64;
         let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (d.len() - 1) as f64;
         let tau = tau_n as f64 / 10.0;
-        out += &format!(" tau {tau}: N/pred {:.3} (n {})", (var / tau).sqrt() / pred, d.len());
+        out += &format!(
+            " tau {tau}: N/pred {:.3} (n {})",
+            (var / tau).sqrt() / pred,
+            d.len()
+        );
     }
     let mean_rate = (e[e.len() - 1] - e[0]) / (dur - 0.1) * 3600.0;
     println!("K {} OL {} Od {} fd {} noise {} rate {}: sigma_phi {:.2} rad, pred {:.3e} deg/rts |{out} | mean err {mean_rate:.4} deg/h | wall {wall:.1} s",

@@ -332,12 +332,12 @@ pub struct Reading {
 /// Gauss-Legendre, 8 nodes on [-1, 1].
 const GL_X: [f64; 4] = [
     0.183_434_642_495_649_8,
-    0.525_532_409_916_329_0,
+    0.525_532_409_916_329,
     0.796_666_477_413_626_7,
     0.960_289_856_497_536_3,
 ];
 const GL_W: [f64; 4] = [
-    0.362_683_783_378_362_0,
+    0.362_683_783_378_362,
     0.313_706_645_877_887_3,
     0.222_381_034_453_374_5,
     0.101_228_536_290_376_3,
@@ -347,7 +347,6 @@ const GL_W: [f64; 4] = [
 /// 9th-order Taylor polynomial of the dither angle is exact to 1e-9).
 const MAX_PIECE: f64 = 0.19;
 const TAYLOR: usize = 10;
-
 
 /// The dithered RLG; `F` is the float of the inner loops (f64 on the host,
 /// f32 under QEMU), the bookkeeping is f64. Time is kept as the current
@@ -396,8 +395,8 @@ impl<F: Float> DitheredRlg<F> {
         let f0: f64 = StandardUniform.sample(&mut pd_rng);
         // Omega_dot at the largest amplitude the noise draws (4 sigma).
         let od = p.omega_dot() * (1.0 + 4.0 * p.noise_frac) * (1.0 + p.fd_drift_frac).powi(2);
-        let w_rate = (p.accuracy.c1 * (od / (2.0 * PI * k_fr)).sqrt())
-            .max(p.accuracy.c2 * p.lock_in_dps);
+        let w_rate =
+            (p.accuracy.c1 * (od / (2.0 * PI * k_fr)).sqrt()).max(p.accuracy.c2 * p.lock_in_dps);
         let cur = motion.current();
         Self {
             p,
@@ -711,14 +710,9 @@ impl<F: Float> DitheredRlg<F> {
         // The photodiodes a little later: the dither and input angle move
         // on (exactly), the lock-in error by its rate.
         let xa = x + self.p.adc_delay_s;
-        let de = -self.kappa
-            * (2.0 * PI * frac(fr) + self.p.beta_rad).sin()
-            * self.p.adc_delay_s;
-        let fr_adc = self.f0
-            + psi
-            + self.k_fr * (rate * self.p.adc_delay_s + hc.theta_x(xa))
-            + e
-            + de;
+        let de = -self.kappa * (2.0 * PI * frac(fr) + self.p.beta_rad).sin() * self.p.adc_delay_s;
+        let fr_adc =
+            self.f0 + psi + self.k_fr * (rate * self.p.adc_delay_s + hc.theta_x(xa)) + e + de;
         Latch {
             t_s: hc.t0 + x,
             counter: counts as u16,
@@ -857,7 +851,8 @@ fn sin_small<F: Float>(x: F) -> F {
                     + r2 * (c(-1.0 / 720.0)
                         + r2 * (c(1.0 / 40_320.0)
                             + r2 * (c(-1.0 / 3_628_800.0)
-                                + r2 * (c(1.0 / 479_001_600.0) + r2 * c(-1.0 / 87_178_291_200.0)))))))
+                                + r2 * (c(1.0 / 479_001_600.0)
+                                    + r2 * c(-1.0 / 87_178_291_200.0)))))))
     };
     match q.to_i64().unwrap_or(0).rem_euclid(4) {
         0 => sin(),

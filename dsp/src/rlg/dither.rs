@@ -78,7 +78,10 @@ const ATAN_TURNS: [u32; 16] = [
 /// turn along +y), by 16 CORDIC rotations (error below 2e-5 turn).
 /// |x|, |y| < 2^14.
 pub fn atan2_turns(y: i32, x: i32) -> u32 {
-    let (mut x, mut y) = (x.clamp(-16_383, 16_383) << 16, y.clamp(-16_383, 16_383) << 16);
+    let (mut x, mut y) = (
+        x.clamp(-16_383, 16_383) << 16,
+        y.clamp(-16_383, 16_383) << 16,
+    );
     let mut z: u32 = 0;
     if x < 0 {
         // Into the right half plane by half a turn.

@@ -16,7 +16,7 @@ pub mod dither;
 pub mod thermal;
 
 pub use channel::{compensate_rate_ndps, FrameSpan, RlgChannel, RlgConfig, RlgWords};
-pub use dither::{DitherStripper, LatchSample, StripConfig, StripFlags};
 pub use coeffs::{CoeffError, ThermalCoeffs};
 pub use counter::PulseCounter;
+pub use dither::{DitherStripper, LatchSample, StripConfig, StripFlags};
 pub use thermal::{RlgFlags, Temperatures, ThermalComp};

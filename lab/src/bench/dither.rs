@@ -192,8 +192,7 @@ pub fn run_all(
     done: &(dyn Fn(usize, &DitherSummary) + Sync),
 ) -> Result<Vec<DitherSummary>, String> {
     let next = AtomicUsize::new(0);
-    let out: Mutex<Vec<Option<Result<DitherSummary, String>>>> =
-        Mutex::new(vec![None; jobs.len()]);
+    let out: Mutex<Vec<Option<Result<DitherSummary, String>>>> = Mutex::new(vec![None; jobs.len()]);
     std::thread::scope(|s| {
         for _ in 0..threads.max(1) {
             s.spawn(|| loop {
@@ -211,7 +210,9 @@ pub fn run_all(
             });
         }
     });
-    let out = out.into_inner().map_err(|_| "a bench thread panicked".to_string())?;
+    let out = out
+        .into_inner()
+        .map_err(|_| "a bench thread panicked".to_string())?;
     out.into_iter()
         .map(|r| r.unwrap_or_else(|| Err("a point did not run".into())))
         .collect()

@@ -89,8 +89,16 @@ pub fn run_bench(a: &DitherBenchArgs) -> Result<(), LabError> {
     let arw_s = run_all(&arw_jobs, threads, &tick).map_err(LabError::Bench)?;
     let rate_s = run_all(&rate_jobs, threads, &tick).map_err(LabError::Bench)?;
     bar.finish_and_clear();
-    let arw: Vec<ArwRow> = arw_jobs.iter().zip(&arw_s).map(|(j, s)| arw_row(j, s)).collect();
-    let rate: Vec<RateRow> = rate_jobs.iter().zip(&rate_s).map(|(j, s)| rate_row(j, s)).collect();
+    let arw: Vec<ArwRow> = arw_jobs
+        .iter()
+        .zip(&arw_s)
+        .map(|(j, s)| arw_row(j, s))
+        .collect();
+    let rate: Vec<RateRow> = rate_jobs
+        .iter()
+        .zip(&rate_s)
+        .map(|(j, s)| rate_row(j, s))
+        .collect();
     let ratios: Vec<f64> = arw.iter().filter_map(|r| r.ratio).collect();
     let mean = (!ratios.is_empty()).then(|| ratios.iter().sum::<f64>() / ratios.len() as f64);
     let summary = Summary {
@@ -162,7 +170,15 @@ pub fn run_bench(a: &DitherBenchArgs) -> Result<(), LabError> {
             );
             println!(
                 "{:>6} {:>8} {:>6} | {:>12} {:>9} {:>12} {:>5} {:>10} {:>8}",
-                "noise", "rate", "zones", "err dph", "se", "predicted", "zone", "res LI dph", "kappa"
+                "noise",
+                "rate",
+                "zones",
+                "err dph",
+                "se",
+                "predicted",
+                "zone",
+                "res LI dph",
+                "kappa"
             );
             for r in &rate {
                 println!(
@@ -196,9 +212,5 @@ pub fn run_bench(a: &DitherBenchArgs) -> Result<(), LabError> {
             s.rate_points
         );
     }
-    print_json(&Out {
-        arw,
-        rate,
-        summary,
-    })
+    print_json(&Out { arw, rate, summary })
 }

@@ -22,6 +22,9 @@ pub const CLOCK_HZ: u32 = 84_000_000;
 /// of the range hide the walk's slope from the fit.
 pub const ALLAN_FRAMES: usize = 10;
 
+/// Where a run hands each frame (a run file's writer).
+pub type RowSink<'a, E> = &'a mut dyn FnMut(&DitherRow) -> Result<(), E>;
+
 /// One run's settings.
 #[derive(Clone, Copy, Debug)]
 pub struct DitherRun {
@@ -122,15 +125,53 @@ impl DitherRun {
         let g = &self.gyro;
         let pos = |v: f64| v.is_finite() && v > 0.0;
         let checks: [(&'static str, f64, bool); 9] = [
-            ("counts-per-deg", g.counts_per_deg, pos(g.counts_per_deg) && g.counts_per_deg <= 1e6),
-            ("lock-in-dps", g.lock_in_dps, g.lock_in_dps.is_finite() && (0.0..=10.0).contains(&g.lock_in_dps)),
-            ("dither-dps", g.dither_dps, pos(g.dither_dps) && g.dither_dps <= 2000.0),
-            ("dither-hz", g.dither_hz, (100.0..=2000.0).contains(&g.dither_hz)),
-            ("dither-noise-frac", g.noise_frac, (0.0..=0.2).contains(&g.noise_frac)),
-            ("rate-dps", self.rate_dps, self.rate_dps.is_finite() && self.rate_dps.abs() < 0.9 * g.dither_dps),
-            ("duration-s", self.duration_s, self.duration_s.is_finite() && self.duration_s >= self.settle_s + 2.0 && self.duration_s <= 1e6),
-            ("fd-drift-frac", g.fd_drift_frac, (0.0..=0.1).contains(&g.fd_drift_frac)),
-            ("pickoff-delay-ns", g.pickoff_delay_s * 1e9, (0.0..=5e-6).contains(&g.pickoff_delay_s)),
+            (
+                "counts-per-deg",
+                g.counts_per_deg,
+                pos(g.counts_per_deg) && g.counts_per_deg <= 1e6,
+            ),
+            (
+                "lock-in-dps",
+                g.lock_in_dps,
+                g.lock_in_dps.is_finite() && (0.0..=10.0).contains(&g.lock_in_dps),
+            ),
+            (
+                "dither-dps",
+                g.dither_dps,
+                pos(g.dither_dps) && g.dither_dps <= 2000.0,
+            ),
+            (
+                "dither-hz",
+                g.dither_hz,
+                (100.0..=2000.0).contains(&g.dither_hz),
+            ),
+            (
+                "dither-noise-frac",
+                g.noise_frac,
+                (0.0..=0.2).contains(&g.noise_frac),
+            ),
+            (
+                "rate-dps",
+                self.rate_dps,
+                self.rate_dps.is_finite() && self.rate_dps.abs() < 0.9 * g.dither_dps,
+            ),
+            (
+                "duration-s",
+                self.duration_s,
+                self.duration_s.is_finite()
+                    && self.duration_s >= self.settle_s + 2.0
+                    && self.duration_s <= 1e6,
+            ),
+            (
+                "fd-drift-frac",
+                g.fd_drift_frac,
+                (0.0..=0.1).contains(&g.fd_drift_frac),
+            ),
+            (
+                "pickoff-delay-ns",
+                g.pickoff_delay_s * 1e9,
+                (0.0..=5e-6).contains(&g.pickoff_delay_s),
+            ),
         ];
         for (name, v, ok) in checks {
             if !ok {
@@ -170,7 +211,7 @@ impl DitherRun {
     /// `progress`; then the analysis.
     pub fn run<E: From<DitherRunError>>(
         &self,
-        mut on_row: Option<&mut dyn FnMut(&DitherRow) -> Result<(), E>>,
+        mut on_row: Option<RowSink<'_, E>>,
         mut progress: impl FnMut(u64),
     ) -> Result<DitherSummary, E> {
         self.check()?;
@@ -246,7 +287,8 @@ impl DitherRun {
         let term = |v: f64| t.present[ARW].then(|| to_units(ARW, v));
         let rms_about_mean = |v: &[f64]| {
             let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
-            let rms = (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len().max(1) as f64).sqrt();
+            let rms =
+                (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len().max(1) as f64).sqrt();
             let max = v.iter().map(|x| (x - m).abs()).fold(0.0, f64::max);
             (rms, max)
         };

@@ -117,8 +117,8 @@ pub fn predict(p: &DitherParams, rate_dps: f64) -> Prediction {
 /// Mean velocity and effective diffusion of `dx/dt = -a sin x + F +
 /// sqrt(2 D) xi` (period 2 pi): `v = 2 pi (1 - e^(-2 pi F/D)) / int I+`,
 /// `D_eff = D <I+^2 I-> / <I+>^3` with `I+(x) = (1/D) int_0^2pi
-/// exp((V(x) - V(x-y) - F y)/D) dy`, `I-(x) = (1/D) int_0^2pi exp((V(x+y)
-/// - V(x) - F y)/D) dy`, `V = -a cos x`. Exponents are taken relative to
+/// exp((V(x) - V(x-y) - F y)/D) dy`, `I-(x) = (1/D) int_0^2pi
+/// exp((V(x+y) - V(x) - F y)/D) dy`, `V = -a cos x`. Exponents are taken relative to
 /// their largest (the integrals' ratio is scale free); without noise the
 /// deterministic Adler answer.
 pub fn washboard(a: f64, tilt: f64, d: f64) -> (f64, f64) {

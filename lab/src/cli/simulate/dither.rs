@@ -92,14 +92,19 @@ impl From<DitherRunError> for LabError {
             DitherRunError::OutOfRange(name, v) => {
                 LabError::Usage(format!("--{name} {v}: out of range"))
             }
-            DitherRunError::Analysis(m) => LabError::Bench(format!("Allan analysis of the run: {m}")),
+            DitherRunError::Analysis(m) => {
+                LabError::Bench(format!("Allan analysis of the run: {m}"))
+            }
         }
     }
 }
 
 pub fn run(a: &DitherArgs) -> Result<(), LabError> {
     if !(a.settle_s.is_finite() && a.settle_s >= 0.0) {
-        return Err(LabError::Usage(format!("--settle-s {}: out of range", a.settle_s)));
+        return Err(LabError::Usage(format!(
+            "--settle-s {}: out of range",
+            a.settle_s
+        )));
     }
     let r = a.run_params();
     r.check()?;
