@@ -152,13 +152,23 @@ pub fn washboard(a: f64, tilt: f64, d: f64) -> (f64, f64) {
             top = top.max(e_plus(i, j)).max(e_minus(i, j));
         }
     }
-    // Trapezoid in y (the integrand is not periodic in y with a tilt),
-    // scaled by e^-top; the sums in x are periodic (spectral).
+    // In y the exponent is taken linear across each cell and integrated
+    // exactly (the integrand is not periodic in y with a tilt, and a tilt
+    // far above D makes it fall by many e-folds within one cell, where a
+    // trapezoid fails), scaled by e^-top; the sums in x are periodic
+    // (spectral).
     let integral = |e: &dyn Fn(usize, usize) -> f64, i: usize| {
         let mut s = 0.0;
-        for j in 0..=n {
-            let w = if j == 0 || j == n { 0.5 } else { 1.0 };
-            s += w * (e(i, j) - top).exp();
+        let mut e0 = e(i, 0) - top;
+        for j in 1..=n {
+            let e1 = e(i, j) - top;
+            let de = e1 - e0;
+            s += if de.abs() < 1e-6 {
+                0.5 * (e0.exp() + e1.exp())
+            } else {
+                (e1.exp() - e0.exp()) / de
+            };
+            e0 = e1;
         }
         s * h / d
     };
