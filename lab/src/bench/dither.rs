@@ -10,7 +10,7 @@
 //!   `f_d/K` (K in fringes per degree), without the amplitude noise, with
 //!   a little and with enough.
 
-use crate::sim::dither_run::{DitherRun, DitherSummary};
+use crate::sim::dither_run::{DitherRun, DitherRunError, DitherSummary};
 use gyro_sim::rlg_dither::{Accuracy, DitherParams};
 use rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardUniform};
@@ -190,17 +190,16 @@ pub fn run_all(
     jobs: &[DitherRun],
     threads: usize,
     done: &(dyn Fn(usize, &DitherSummary) + Sync),
-) -> Result<Vec<DitherSummary>, String> {
+) -> Result<Vec<DitherSummary>, DitherRunError> {
     let next = AtomicUsize::new(0);
-    let out: Mutex<Vec<Option<Result<DitherSummary, String>>>> = Mutex::new(vec![None; jobs.len()]);
+    let out: Mutex<Vec<Option<Result<DitherSummary, DitherRunError>>>> =
+        Mutex::new((0..jobs.len()).map(|_| None).collect());
     std::thread::scope(|s| {
         for _ in 0..threads.max(1) {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(job) = jobs.get(i) else { break };
-                let r = job
-                    .run::<crate::sim::dither_run::DitherRunError>(None, |_| {})
-                    .map_err(|e| format!("{e:?}"));
+                let r = job.run::<DitherRunError>(None, |_| {});
                 if let Ok(s) = &r {
                     done(i, s);
                 }
@@ -212,8 +211,8 @@ pub fn run_all(
     });
     let out = out
         .into_inner()
-        .map_err(|_| "a bench thread panicked".to_string())?;
+        .map_err(|_| DitherRunError::Analysis("a bench thread panicked".into()))?;
     out.into_iter()
-        .map(|r| r.unwrap_or_else(|| Err("a point did not run".into())))
+        .map(|r| r.unwrap_or_else(|| Err(DitherRunError::Analysis("a point did not run".into()))))
         .collect()
 }

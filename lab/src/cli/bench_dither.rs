@@ -86,8 +86,10 @@ pub fn run_bench(a: &DitherBenchArgs) -> Result<(), LabError> {
     let total = (arw_jobs.len() + rate_jobs.len()) as u64;
     let bar = progress_bar(total, "{bar:40} {pos}/{len} {eta}", a.json.json);
     let tick = |_: usize, _: &crate::sim::dither_run::DitherSummary| bar.inc(1);
-    let arw_s = run_all(&arw_jobs, threads, &tick).map_err(LabError::Bench)?;
-    let rate_s = run_all(&rate_jobs, threads, &tick).map_err(LabError::Bench)?;
+    let arw_s =
+        run_all(&arw_jobs, threads, &tick).map_err(|e| LabError::Bench(format!("{e:?}")))?;
+    let rate_s =
+        run_all(&rate_jobs, threads, &tick).map_err(|e| LabError::Bench(format!("{e:?}")))?;
     bar.finish_and_clear();
     let arw: Vec<ArwRow> = arw_jobs
         .iter()

@@ -115,7 +115,7 @@ pub fn run(a: &DitherArgs) -> Result<(), LabError> {
             &format!(
                 "gyro-lab simulate dither: K {} counts/deg, Omega_L {} deg/s, dither {} deg/s at {} Hz, \
                  noise {}, seed {}\nframes at {} Hz; the stripped angle of a frame stands for the update \
-                 before it (t_s); residual_counts: stripped minus the gyro's angle without the dither",
+                 before it (its time); residual_counts: stripped minus the gyro's angle without the dither",
                 a.counts_per_deg,
                 a.lock_in_dps,
                 a.dither_dps,
