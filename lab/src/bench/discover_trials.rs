@@ -230,6 +230,7 @@ pub fn model_of(g: GyroKind, effects: Vec<ModelEffect>) -> Model {
         gyro: g,
         nominal: toml::Table::new(),
         effects,
+        terms: vec![],
     }
 }
 

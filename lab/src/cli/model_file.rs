@@ -2,9 +2,12 @@
 //! `simulate run`): the text is model/file.rs's.
 
 use crate::error::{ColumnRef, LabError};
-use crate::model::file::{check_on_run, parse_placed, to_toml, ModelFileError, Places};
+use crate::model::file::{
+    check_on_run, check_terms_on_run, parse_placed, to_toml, ModelFileError, Placed,
+};
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::Model;
+use crate::model::inputs::Inputs;
 use crate::model::ranges::Extent;
 use std::path::{Path, PathBuf};
 
@@ -13,7 +16,7 @@ pub struct ModelFile {
     pub model: Model,
     path: PathBuf,
     text: String,
-    places: Vec<Places>,
+    places: Placed,
 }
 
 impl ModelFile {
@@ -23,12 +26,13 @@ impl ModelFile {
         check_on_run(&self.text, &self.model, &self.places, extent)
             .map_err(|e| placed(&self.path, e))
     }
-}
 
-/// Reads and checks a model file for a gyro of kind `gyro` (the one
-/// `--gyro` or the profile asks for).
-pub fn read_model(path: &Path, gyro: GyroKind) -> Result<Model, LabError> {
-    read_model_file(path, gyro).map(|m| m.model)
+    /// The terms evaluated on the run: one that cannot be (a division by
+    /// zero, a column the run lacks) refused at its place in the formula.
+    pub fn check_terms(&self, inp: &Inputs) -> Result<(), LabError> {
+        check_terms_on_run(&self.text, &self.model, &self.places, inp)
+            .map_err(|e| placed(&self.path, e))
+    }
 }
 
 /// [`read_model`], keeping the text for the checks on a run.

@@ -15,12 +15,18 @@
 //! name = "scale_factor_knee"
 //! knee_c = 48.0
 //! slope_change_ppm_per_c = 6.0
+//! [[effect]]
+//! name = "term"                # outside the library (model/term/)
+//! formula = "k_dph * ref_rate_dps^2"
+//! k_dph = -1.2e-3
 //! ```
 
 use super::effects::Effect;
 use super::gyro_kind::GyroKind;
 use super::gyro_model::{Model, ModelEffect};
+use super::inputs::Inputs;
 use super::ranges::{domain_error, Extent};
+use super::term::Term;
 use std::collections::BTreeMap;
 
 pub const VERSION: u16 = 1;
@@ -86,9 +92,14 @@ pub type Places = BTreeMap<String, usize>;
 /// The byte offset of the value of `key` inside the table text at `span`
 /// (its `key = value` line), else the table's start.
 fn value_offset(text: &str, span: &std::ops::Range<usize>, key: &str) -> usize {
-    let body = &text[span.start.min(text.len())..span.end.min(text.len())];
+    // The table's span may cover only its `[[effect]]` header: its keys
+    // run from there to the next header.
+    let body = &text[span.start.min(text.len())..];
     let mut off = span.start;
-    for line in body.split_inclusive('\n') {
+    for (i, line) in body.split_inclusive('\n').enumerate() {
+        if i > 0 && line.trim_start().starts_with('[') {
+            break;
+        }
         let trimmed = line.trim_start();
         let lead = line.len() - trimmed.len();
         if let Some(rest) = trimmed.strip_prefix(key) {
@@ -177,6 +188,80 @@ fn effect(
     Ok((ModelEffect { effect, params }, places))
 }
 
+/// The name of a term outside the library, and its formula's key.
+pub const TERM: &str = "term";
+const FORMULA: &str = "formula";
+
+/// One `[[effect]]` table with `name = "term"`: its formula (a TOML string
+/// on one line, so a place in the formula is a place in the file) and its
+/// parameters, every one a finite number the formula uses. Its places:
+/// `formula` at the formula's first character.
+fn term(text: &str, e: toml::Spanned<RawEffect>) -> Result<(Term, Places), ModelFileError> {
+    let span = e.span();
+    let e = e.into_inner();
+    let mut params = BTreeMap::new();
+    let mut places = Places::new();
+    let mut formula = None;
+    for (k, v) in &e.params {
+        let place = value_offset(text, &span, k);
+        if k == FORMULA {
+            let Some(f) = v.as_str() else {
+                return Err(ModelFileError::at(
+                    text,
+                    place,
+                    "term: `formula` is not a string".into(),
+                ));
+            };
+            // Past the opening quote of a basic or literal string.
+            let start = place + 1;
+            if text.get(start..start + f.len()) != Some(f) {
+                return Err(ModelFileError::at(
+                    text,
+                    place,
+                    "term: write the formula on one line, without escapes".into(),
+                ));
+            }
+            formula = Some(f.to_string());
+            places.insert(FORMULA.into(), start);
+            continue;
+        }
+        match v.as_float().or(v.as_integer().map(|i| i as f64)) {
+            Some(x) if x.is_finite() => {
+                params.insert(k.clone(), x);
+                places.insert(k.clone(), place);
+            }
+            _ => {
+                return Err(ModelFileError::at(
+                    text,
+                    place,
+                    format!("term: parameter `{k}` is not a finite number"),
+                ))
+            }
+        }
+    }
+    let Some(formula) = formula else {
+        return Err(ModelFileError::at(
+            text,
+            span.start,
+            format!(
+                "term: no `formula` (e.g. formula = \"k_dph * {}^2\")",
+                crate::data::run_file::Column::RefRate.name()
+            ),
+        ));
+    };
+    let at = places[FORMULA];
+    let t = Term::new(&formula, params)
+        .map_err(|e| ModelFileError::at(text, at + e.span.start, format!("term: {}", e.msg)))?;
+    Ok((t, places))
+}
+
+/// Where the values of a model file's effects and terms are, in order.
+#[derive(Clone, Debug, Default)]
+pub struct Placed {
+    pub effects: Vec<Places>,
+    pub terms: Vec<Places>,
+}
+
 /// Reads and checks the text of a model file for a gyro of kind `expect`.
 pub fn parse(text: &str, expect: GyroKind) -> Result<Model, ModelFileError> {
     parse_placed(text, expect).map(|(m, _)| m)
@@ -184,7 +269,7 @@ pub fn parse(text: &str, expect: GyroKind) -> Result<Model, ModelFileError> {
 
 /// [`parse`], with where each effect's parameter values are in the text
 /// (for the checks that need the run, [`check_on_run`]).
-pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Vec<Places>), ModelFileError> {
+pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Placed), ModelFileError> {
     let raw: RawModel = toml::from_str(text).map_err(|e| {
         let msg = e.message().replace('\n', " ");
         match e.span() {
@@ -225,20 +310,28 @@ pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Vec<Places>)
             asked: expect,
         });
     }
-    let (effects, places): (Vec<ModelEffect>, Vec<Places>) = raw
-        .effect
-        .into_iter()
-        .map(|e| effect(text, e, gyro))
-        .collect::<Result<Vec<_>, _>>()?
-        .into_iter()
-        .unzip();
+    let mut effects = vec![];
+    let mut terms = vec![];
+    let mut placed = Placed::default();
+    for e in raw.effect {
+        if e.get_ref().name.get_ref() == TERM {
+            let (t, p) = term(text, e)?;
+            terms.push(t);
+            placed.terms.push(p);
+        } else {
+            let (m, p) = effect(text, e, gyro)?;
+            effects.push(m);
+            placed.effects.push(p);
+        }
+    }
     Ok((
         Model {
             gyro,
             nominal: raw.nominal,
             effects,
+            terms,
         },
-        places,
+        placed,
     ))
 }
 
@@ -247,10 +340,10 @@ pub fn parse_placed(text: &str, expect: GyroKind) -> Result<(Model, Vec<Places>)
 pub fn check_on_run(
     text: &str,
     model: &Model,
-    places: &[Places],
+    placed: &Placed,
     extent: &Extent,
 ) -> Result<(), ModelFileError> {
-    for (e, pl) in model.effects.iter().zip(places) {
+    for (e, pl) in model.effects.iter().zip(&placed.effects) {
         for (k, v) in &e.params {
             if let Some(why) = domain_error(e.effect, k, *v, Some(extent)) {
                 let off = pl.get(k).copied().unwrap_or(0);
@@ -263,6 +356,25 @@ pub fn check_on_run(
         }
     }
     Ok(())
+}
+
+/// The terms on the run: the first that cannot be evaluated (a division
+/// by zero, a column the run lacks, a value that is not finite), at its
+/// place in the formula.
+pub fn check_terms_on_run(
+    text: &str,
+    model: &Model,
+    placed: &Placed,
+    inp: &Inputs,
+) -> Result<(), ModelFileError> {
+    model.check_terms(inp).map_err(|(i, e)| {
+        let at = placed.terms.get(i).and_then(|p| p.get(FORMULA)).copied();
+        ModelFileError::at(
+            text,
+            at.unwrap_or(0) + e.span.start,
+            format!("term: {}", e.msg),
+        )
+    })
 }
 
 /// The model as a model file's text.
@@ -285,9 +397,96 @@ pub fn to_toml(model: &Model) -> String {
             }
             toml::Value::Table(m)
         })
+        .chain(model.terms.iter().map(|t| {
+            let mut m = toml::Table::new();
+            m.insert("name".into(), TERM.into());
+            m.insert(FORMULA.into(), t.formula.clone().into());
+            for (k, v) in &t.params {
+                m.insert(k.clone(), (*v).into());
+            }
+            toml::Value::Table(m)
+        }))
         .collect();
     if !effects.is_empty() {
         t.insert("effect".into(), toml::Value::Array(effects));
     }
     toml::to_string(&t).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::run_file::Column;
+
+    fn model_text(term: &str) -> String {
+        format!("kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n[[effect]]\nname = \"bias\"\nbias_dph = 0.5\n[[effect]]\nname = \"term\"\n{term}\n")
+    }
+
+    fn err_at(text: &str) -> (u64, usize, String) {
+        match parse(text, GyroKind::Fog) {
+            Err(ModelFileError::At { line, column, msg }) => (line, column, msg),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_term_reads_and_writes_back_the_same_model() {
+        let w = Column::RefRate.name();
+        let text = model_text(&format!("formula = \"k_dph * {w}^2\"\nk_dph = -1.2e-3"));
+        let m = parse(&text, GyroKind::Fog).unwrap();
+        assert_eq!(m.effects.len(), 1);
+        assert_eq!(m.terms.len(), 1);
+        assert_eq!(m.terms[0].params["k_dph"], -1.2e-3);
+        let again = parse(&to_toml(&m), GyroKind::Fog).unwrap();
+        assert_eq!(again, m);
+    }
+
+    #[test]
+    fn a_bad_term_is_refused_at_its_place() {
+        // Line 9 is the formula's; column 12 its first character.
+        let (line, col, msg) = err_at(&model_text("formula = \"k * (x + \"\nk = 1"));
+        assert_eq!((line, col), (9, 21), "{msg}");
+        let (line, col, msg) = err_at(&model_text("formula = \"k * speed\"\nk = 1"));
+        assert_eq!((line, col), (9, 16), "{msg}");
+        assert!(msg.contains("unknown name `speed`"), "{msg}");
+        let (line, _, msg) = err_at(&model_text("formula = \"k * pi\"\nk = 1\nc = 2"));
+        assert_eq!(line, 9);
+        assert!(msg.contains("parameter `c` is not used"), "{msg}");
+        let (line, col, msg) = err_at(&model_text("formula = \"k * pi\"\nk = \"one\""));
+        assert_eq!((line, col), (10, 5), "{msg}");
+        let (line, _, msg) = err_at(&model_text("k = 1"));
+        assert_eq!(line, 7, "{msg}");
+        assert!(msg.contains("no `formula`"), "{msg}");
+    }
+
+    #[test]
+    fn a_term_that_divides_by_zero_on_the_run_is_refused_there() {
+        let t = Column::Time.name();
+        let text = model_text(&format!("formula = \"k / ({t} - 3)\"\nk = 1"));
+        let (m, placed) = parse_placed(&text, GyroKind::Fog).unwrap();
+        let inp = Inputs::new(
+            (0..10).map(|k| k as f64).collect(),
+            vec![0.0; 10],
+            None,
+            None,
+            None,
+            None,
+        );
+        match check_terms_on_run(&text, &m, &placed, &inp) {
+            Err(ModelFileError::At { line, column, msg }) => {
+                // The divisor `(t_s - 3)` starts at the formula's 5th character.
+                assert_eq!((line, column), (9, 16), "{msg}");
+                assert!(msg.contains("divides by zero"), "{msg}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // The model's output is the reference plus bias and term elsewhere.
+        let text = model_text(&format!("formula = \"k * {t}\"\nk = 36"));
+        let m = parse(&text, GyroKind::Fog).unwrap();
+        let y = m.evaluate(&inp);
+        for (k, y) in y.iter().enumerate() {
+            let want = (0.5 + 36.0 * k as f64) / 3600.0;
+            assert!((y - want).abs() < 1e-15, "{k}: {y} against {want}");
+        }
+    }
 }

@@ -6,6 +6,7 @@
 use super::effects::Effect;
 use super::gyro_kind::GyroKind;
 use super::inputs::Inputs;
+use super::term::{EvalError, Term};
 use crate::data::run_file::Column;
 use std::collections::BTreeMap;
 
@@ -21,6 +22,8 @@ pub struct Model {
     pub gyro: GyroKind,
     pub nominal: toml::Table,
     pub effects: Vec<ModelEffect>,
+    /// Terms outside the library (`name = "term"`), after the effects.
+    pub terms: Vec<Term>,
 }
 
 impl Model {
@@ -30,6 +33,7 @@ impl Model {
             gyro,
             nominal: toml::Table::new(),
             effects: vec![],
+            terms: vec![],
         }
     }
 
@@ -43,12 +47,30 @@ impl Model {
             .collect()
     }
 
-    /// The simulated output, deg/s: reference rate plus every effect.
+    /// The first term that cannot be evaluated on this run (its index and
+    /// why): the commands refuse such a model at the formula's place
+    /// before they evaluate it.
+    pub fn check_terms(&self, inp: &Inputs) -> Result<(), (usize, EvalError)> {
+        for (i, t) in self.terms.iter().enumerate() {
+            t.evaluate(inp).map_err(|e| (i, e))?;
+        }
+        Ok(())
+    }
+
+    /// The simulated output, deg/s: reference rate plus every effect and
+    /// term. A term that cannot be evaluated on the run ([`Self::check_terms`])
+    /// makes the output NaN, never a silent zero.
     pub fn evaluate(&self, inp: &Inputs) -> Vec<f64> {
         let mut y = inp.w.clone();
         for e in &self.effects {
             for (o, c) in y.iter_mut().zip(e.effect.contribution(inp, &e.params)) {
                 *o += c;
+            }
+        }
+        for t in &self.terms {
+            match t.evaluate(inp) {
+                Ok(v) => y.iter_mut().zip(v).for_each(|(o, c)| *o += c / 3600.0),
+                Err(_) => y.iter_mut().for_each(|o| *o = f64::NAN),
             }
         }
         y

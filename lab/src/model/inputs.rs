@@ -2,7 +2,9 @@
 //! reference rate, the temperatures the run has, and the angular
 //! acceleration.
 
+use crate::data::run_file::Column;
 use crate::numerics::thermal_difference::dt_and_gradient;
+use std::collections::BTreeMap;
 
 /// Half width of the temperature rate's slope, s: wide enough to average
 /// a sensor's quantization and noise, short against a coil's thermal lag
@@ -62,6 +64,8 @@ pub struct Inputs {
     /// and its filtered derivative, degC and degC/s.
     pub dt: Option<Vec<f64>>,
     pub grad: Option<Vec<f64>>,
+    /// The two monoblock sensors as read, degC (for terms that name them).
+    pub mono: Option<(Vec<f64>, Vec<f64>)>,
     /// Case sensor, degC.
     pub case: Option<Vec<f64>>,
     /// Angular acceleration, deg/s^2, and whether it was derived from the
@@ -80,9 +84,9 @@ impl Inputs {
         case: Option<Vec<f64>>,
         acc: Option<Vec<f64>>,
     ) -> Self {
-        let (dt, grad) = match mono {
+        let (dt, grad) = match &mono {
             Some((a, b)) => {
-                let (d, g) = dt_and_gradient(&t, &a, &b);
+                let (d, g) = dt_and_gradient(&t, a, b);
                 (Some(d), Some(g))
             }
             None => (None, None),
@@ -112,10 +116,33 @@ impl Inputs {
             temp_rate,
             dt,
             grad,
+            mono,
             case,
             acc,
             acc_derived,
         }
+    }
+
+    /// The run's input columns present, by their run-file names (what a
+    /// term's formula reads; the acceleration only where the run has it).
+    pub fn columns(&self) -> BTreeMap<&'static str, &[f64]> {
+        let mut c = BTreeMap::new();
+        c.insert(Column::Time.name(), self.t.as_slice());
+        c.insert(Column::RefRate.name(), self.w.as_slice());
+        if let Some(x) = &self.temp {
+            c.insert(Column::Temp.name(), x.as_slice());
+        }
+        if let Some((a, b)) = &self.mono {
+            c.insert(Column::MonoA.name(), a.as_slice());
+            c.insert(Column::MonoB.name(), b.as_slice());
+        }
+        if let Some(x) = &self.case {
+            c.insert(Column::Case.name(), x.as_slice());
+        }
+        if !self.acc_derived {
+            c.insert(Column::RefAcc.name(), self.acc.as_slice());
+        }
+        c
     }
 
     pub fn len(&self) -> usize {

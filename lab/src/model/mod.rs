@@ -10,5 +10,6 @@ pub mod file;
 pub mod gyro_kind;
 pub mod gyro_model;
 pub mod inputs;
+pub mod proposal;
 pub mod ranges;
 pub mod term;

@@ -175,6 +175,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let model = match &file {
         Some(f) => {
             f.check_on_run(&run_extent(&data))?;
+            f.check_terms(&data.inputs)?;
             f.model.clone()
         }
         None => Model::ideal(gyro),

@@ -3,11 +3,11 @@
 //! known effects.
 
 use crate::cli::args::{Json, Out, Seed};
-use crate::cli::model_file::read_model;
+use crate::cli::model_file::read_model_file;
 use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
 use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
-use crate::sim::model_run::{generate, TestProfile, TrialNoise, TrialRun};
+use crate::sim::model_run::{generate, inputs_of, TestProfile, TrialNoise, TrialRun};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -131,7 +131,7 @@ pub struct SimulateRunArgs {
 
 pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
     let profile = TestProfile::from(a.profile);
-    let model = read_model(&a.model, profile.gyro())?;
+    let file = read_model_file(&a.model, profile.gyro())?;
     let (dt0, dur0) = profile.default_timing();
     let dt = a.dt_s.unwrap_or(dt0);
     let dur = a.duration_s.unwrap_or(dur0);
@@ -152,7 +152,10 @@ pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
             .unwrap_or(nom.rate_random_walk_dphsh)
             .max(0.0),
     };
-    let run = generate(&model, profile, noise, a.seed.seed, Some((dt, dur)));
+    // A term must be computable on the profile's inputs before it is run.
+    file.check_terms(&inputs_of(profile, a.seed.seed, Some((dt, dur))))?;
+    let model = &file.model;
+    let run = generate(model, profile, noise, a.seed.seed, Some((dt, dur)));
     write(
         &run,
         &a.out.out,
