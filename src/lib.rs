@@ -15,6 +15,8 @@ pub mod i2c;
 pub mod overrun;
 pub mod reset_cause;
 #[cfg(feature = "hw")]
+pub mod rlg_timers;
+#[cfg(feature = "hw")]
 pub mod sampling;
 #[cfg(feature = "board")]
 pub mod stack;

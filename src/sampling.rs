@@ -252,10 +252,3 @@ pub fn configure_timers(tim1: &pac::tim1::RegisterBlock, tim2: &pac::tim2::Regis
 pub fn start_timers(tim1: &pac::tim1::RegisterBlock) {
     tim1.cr1().modify(|_, w| w.cen().set_bit());
 }
-
-/// TIM4 encoder inputs: digital filter of 8 samples at fCK_INT on both
-/// channels (the HAL's encoder mode sets none).
-pub fn encoder_filter(tim4: &pac::tim3::RegisterBlock) {
-    tim4.ccmr1_input()
-        .modify(|_, w| w.ic1f().set(0b0011).ic2f().set(0b0011));
-}

@@ -185,15 +185,16 @@ fn channel_words_match_formula() {
         };
         let mut raw = 0u16;
         let mut angle = 0.0f64;
-        ch.update(&cfg, raw, Some(&temps));
+        ch.update(&cfg, 0, raw, Some(&temps));
         ch.take_frame();
         for _ in 0..100 {
             angle += rate_dps / 500.0 * k;
             raw = (angle.floor() as i64) as u16;
-            ch.update(&cfg, raw, None);
+            ch.update(&cfg, 0, raw, None);
         }
-        let (counts, n) = ch.take_frame();
-        let w = ch.words(&cfg, counts, n);
+        let span = ch.take_frame();
+        let (counts, n) = (span.counts(), span.updates);
+        let w = ch.words(&cfg, &span);
         let expect = counts as f64 / k / (n as f64 / 500.0) - (0.5 + 0.01 * 40.0) / 3600.0;
         assert!(
             (w.rate_comp_udps as f64 * 1e-6 - expect).abs() <= 1.5e-6,

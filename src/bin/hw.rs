@@ -20,11 +20,15 @@
 //!   timed by the cycle counter); a DMA transfer error restarts the stream,
 //!   flagged; a HardFault logs, leaves a mark in RAM and resets, and the
 //!   first frame after any start says why it started (`reset_cause.rs`).
-//! - RLG: the readout's quadrature pair on PB6/PB7 counts in TIM4's encoder
-//!   mode (x4, input filter 8 samples). The RLG update task (TIM5, 500 Hz,
-//!   below the closure's priority) reads and differences the counter and
-//!   runs the thermal compensation on sensor ticks; its frame words reach
-//!   the closure through a lock-free queue, so the closure is never masked.
+//! - RLG: the readout's quadrature pair on PC6/PC7 counts in TIM3's encoder
+//!   mode (x4, input filter 8 samples); the dither pickoff's comparator (PC8
+//!   and PA1) latches the count in TIM3's CCR3/CCR4 and its time in the
+//!   free-running TIM5's CCR2 at each zero crossing (`rlg_timers.rs`). The
+//!   latch task hands each crossing to the stripping; the RLG update task
+//!   (TIM5's compare, 500 Hz) reads the counter, takes the stripped angle
+//!   and runs the thermal compensation on sensor ticks. Both sit below the
+//!   closure's priority; the frame words reach the closure through a
+//!   lock-free queue, so the closure is never masked.
 //! - Temperatures: TMP117s on I2C1 (PB8/PB9): 0x48 monoblock A, 0x49
 //!   monoblock B, 0x4A case (10 Hz), 0x4B FOG coil (1 Hz). The idle loop
 //!   reads them and queues the readings to the tasks, so no bus transfer runs
@@ -44,13 +48,14 @@ use gyro_fw::app::{
 };
 use gyro_fw::i2c::I2c1;
 use gyro_fw::reset_cause::{reset_cause, HARD_FAULT_MARK, PANIC_MARK};
+use gyro_fw::rlg_timers;
 use gyro_fw::sampling::{self, AdcBuffer, DacBuffer, Sampling};
 use gyro_fw::timing;
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig, FogLoop};
 use gyro_sp::frame::{Frame, FrameBuilder, ResetCause};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
-use gyro_sp::rlg::{RlgChannel, RlgConfig, RlgWords};
+use gyro_sp::rlg::{LatchSample, RlgChannel, RlgConfig, RlgWords, StripConfig};
 use heapless::spsc::{Consumer, Producer, Queue};
 use stm32f4xx_hal::{
     adc::{
@@ -60,19 +65,23 @@ use stm32f4xx_hal::{
         Adc,
     },
     gpio::Speed,
-    pac::{self, I2C1, TIM4, TIM5, USART1},
+    pac::{self, I2C1, TIM3, TIM5, USART1},
     prelude::*,
-    qei::Qei,
-    rcc::{Config, Enable},
+    rcc::{Config, Enable, Reset},
     serial::{config::Config as SerialConfig, Tx},
     spi::{Mode as SpiMode, Phase, Polarity, Spi},
-    timer::{CounterHz, Event, Flag},
+    timer::CounterHz,
     watchdog::IndependentWatchdog,
 };
 use tmp117::Tmp117;
 
 /// RLG scale factor: encoder counts (quadrature edges, x4) per degree.
 const RLG_COUNTS_PER_DEG: f64 = 8_000.0;
+/// The gyro's dither frequency range (the pickoff's half periods outside
+/// 0.8/f_max .. 1.25/f_min are refused or restart the stripping), Hz.
+const DITHER_HZ: (f64, f64) = (250.0, 700.0);
+/// TIM5 ticks per RLG update.
+const RLG_PERIOD: u32 = rlg_timers::CLOCK_HZ / RLG_HZ;
 /// The coil sensor is read every this many sensor cycles (1 Hz): a slower
 /// derivative for the lag lead is a quieter one (its noise scales as
 /// 1/sqrt(period)).
@@ -112,8 +121,8 @@ pub struct Closure {
 pub struct RlgTask {
     cfg: RlgConfig,
     ch: RlgChannel,
-    encoder: Qei<TIM4>,
-    timer: CounterHz<TIM5>,
+    encoder: TIM3,
+    clock: TIM5,
     temps: Consumer<'static, Temperatures, 2>,
     words: Producer<'static, RlgWords, RLG_QUEUE_LEN>,
 }
@@ -143,12 +152,15 @@ mod app {
     use super::*;
 
     #[shared]
-    struct Shared {}
+    struct Shared {
+        /// The RLG channel: the latch and update tasks share it at one
+        /// priority (their locks cost nothing).
+        rlg: RlgTask,
+    }
 
     #[local]
     struct Local {
         closure: Closure,
-        rlg: RlgTask,
         housekeeping: Housekeeping,
     }
 
@@ -179,7 +191,9 @@ mod app {
                 .pclk2(84.MHz()),
         );
         let gpioa = dp.GPIOA.split(&mut rcc);
-        let gpiob = dp.GPIOB.split(&mut rcc);
+        // GPIOB's clock on for the I2C driver (its pins are set up by it).
+        let _gpiob = dp.GPIOB.split(&mut rcc);
+        let gpioc = dp.GPIOC.split(&mut rcc);
         let Ok(usart) = dp.USART1.tx(
             gpioa.pa9,
             SerialConfig::default().baudrate(2_000_000.bps()),
@@ -204,16 +218,23 @@ mod app {
             }
         }
 
-        // RLG: encoder on TIM4, update task on TIM5.
-        let encoder = Qei::new(dp.TIM4, (gpiob.pb6, gpiob.pb7), &mut rcc);
-        // SAFETY: only the input filter bits, which the HAL's Qei never writes.
-        sampling::encoder_filter(unsafe { &*pac::TIM4::ptr() });
+        // RLG: encoder and count latch on TIM3 (PC6/PC7, pickoff PC8), the
+        // latch clock and update compare on TIM5 (pickoff PA1).
+        let _rlg_pins = (
+            gpioc.pc6.into_alternate::<2>(),
+            gpioc.pc7.into_alternate::<2>(),
+            gpioc.pc8.into_alternate::<2>(),
+            gpioa.pa1.into_alternate::<2>(),
+        );
+        TIM3::enable(&mut rcc);
+        TIM3::reset(&mut rcc);
+        TIM5::enable(&mut rcc);
+        TIM5::reset(&mut rcc);
+        let (encoder, clock) = (dp.TIM3, dp.TIM5);
         let thermal = ThermalConfig::from_record(&RLG_RECORD, SENSOR_EVERY as f64 / RLG_HZ as f64);
         if thermal.coeffs_default {
             defmt::warn!("RLG coefficient record refused: running without thermal compensation");
         }
-        let mut rlg_timer = dp.TIM5.counter_hz(&mut rcc);
-        rlg_timer.listen(Event::Update);
 
         // FOG: the DMA ping-pong applies the words written now one closure late.
         let Ok(cfg) = FogConfig::new(fog_params(1)) else {
@@ -327,9 +348,8 @@ mod app {
         // at the sampling phase; interrupts are enabled when init returns.
         // SAFETY: CEN of the timer configured above.
         sampling::start_timers(unsafe { &*pac::TIM1::ptr() });
-        if rlg_timer.start(RLG_HZ.Hz()).is_err() {
-            reset()
-        }
+        rlg_timers::configure_encoder(&encoder);
+        rlg_timers::configure_clock(&clock, RLG_PERIOD);
         defmt::info!(
             "gyro-fw hw: FOG closure at {} Hz, RLG update at {} Hz",
             CLOSURE_HZ,
@@ -339,7 +359,28 @@ mod app {
         // timers started (a few hundred cycles ago: far below half a period).
         sampling.start_clock(DWT::cycle_count());
         (
-            Shared {},
+            Shared {
+                rlg: RlgTask {
+                    cfg: RlgConfig::new(thermal, RLG_COUNTS_PER_DEG, RLG_HZ).with_dither(
+                        StripConfig {
+                            // No photodiode ADC on this board yet: each latch
+                            // stands for its count's middle.
+                            interpolate: false,
+                            ..StripConfig::new(
+                                rlg_timers::CLOCK_HZ,
+                                DITHER_HZ.0,
+                                DITHER_HZ.1,
+                                [0, 0],
+                            )
+                        },
+                    ),
+                    ch: RlgChannel::default(),
+                    encoder,
+                    clock,
+                    temps: temps_rx,
+                    words,
+                },
+            },
             Local {
                 closure: Closure {
                     cfg,
@@ -348,14 +389,6 @@ mod app {
                     out,
                     rlg_words,
                     coil: coil_rx,
-                },
-                rlg: RlgTask {
-                    cfg: RlgConfig::new(thermal, RLG_COUNTS_PER_DEG, RLG_HZ),
-                    ch: RlgChannel::default(),
-                    encoder,
-                    timer: rlg_timer,
-                    temps: temps_rx,
-                    words,
                 },
                 housekeeping: Housekeeping {
                     frames,
@@ -453,18 +486,40 @@ mod app {
 
     /// RLG update (500 Hz, below the closure): counter read and
     /// differenced; on sensor ticks the readings advance the compensation.
-    #[task(binds = TIM5, priority = 1, local = [rlg])]
-    fn rlg_update(cx: rlg_update::Context) {
-        let r = cx.local.rlg;
-        r.timer.clear_flags(Flag::Update);
-        let temps = r.temps.dequeue();
-        r.ch.update(&r.cfg, r.encoder.count(), temps.as_ref());
-        let (counts, n) = r.ch.take_frame();
-        // Full only if the closure has stopped; the counts stay for the next.
-        if r.words.enqueue(r.ch.words(&r.cfg, counts, n)).is_err() {
-            r.ch.restore_frame(counts, n);
-        }
+    #[task(binds = TIM5, priority = 1, shared = [rlg])]
+    fn rlg_update(mut cx: rlg_update::Context) {
+        cx.shared.rlg.lock(|r| {
+            let (time, counter) = rlg_timers::update_read(&r.clock, &r.encoder, RLG_PERIOD);
+            let temps = r.temps.dequeue();
+            r.ch.update(&r.cfg, time, counter, temps.as_ref());
+            let span = r.ch.take_frame();
+            // Full only if the closure has stopped; the counts stay for the next.
+            if r.words.enqueue(r.ch.words(&r.cfg, &span)).is_err() {
+                r.ch.restore_frame(span);
+            }
+        });
         RLG_TICKS.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Dither pickoff zero crossing (the count and its time latched by
+    /// TIM3 and TIM5): handed to the stripping.
+    #[task(binds = TIM3, priority = 1, shared = [rlg])]
+    fn rlg_latch(mut cx: rlg_latch::Context) {
+        cx.shared.rlg.lock(|r| {
+            let (time, latched) = rlg_timers::latch_read(&r.encoder, &r.clock);
+            for l in latched.into_iter().flatten() {
+                if l.overrun {
+                    r.ch.latch_lost();
+                }
+                let sample = LatchSample {
+                    time,
+                    counter: l.counter,
+                    rising: l.rising,
+                    photodiodes: None,
+                };
+                r.ch.latch(&r.cfg, &sample);
+            }
+        });
     }
 }
 

@@ -657,17 +657,18 @@ mod app {
             });
         let closures = CLOSURES.load(Ordering::Relaxed);
         let t0 = SYST::get_current();
-        r.ch.update(&r.cfg, s.counter, temps.as_ref());
+        // Undithered: the update's time only matters to the stripping.
+        r.ch.update(&r.cfg, r.updates, s.counter, temps.as_ref());
         let t1 = SYST::get_current();
         if temps.is_some() && CLOSURES.load(Ordering::Relaxed) == closures {
             r.bench.record(t0, t1);
         }
         r.updates += 1;
-        let (counts, n) = r.ch.take_frame();
+        let span = r.ch.take_frame();
         // Full only if the closure has stopped taking them; the counts then
         // stay in the channel for the next update's words.
-        if r.words.enqueue(r.ch.words(&r.cfg, counts, n)).is_err() {
-            r.ch.restore_frame(counts, n);
+        if r.words.enqueue(r.ch.words(&r.cfg, &span)).is_err() {
+            r.ch.restore_frame(span);
         }
         r.task.record(start, SYST::get_current());
         let b = (r.bench, r.task);

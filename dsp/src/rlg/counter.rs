@@ -42,4 +42,13 @@ impl PulseCounter {
     pub fn angle_counts(&self) -> i64 {
         self.angle
     }
+
+    /// The counts since start that a register value taken within 2^15
+    /// counts of the last read stands for (a latched count); None before
+    /// the first read.
+    #[inline(always)]
+    pub fn unwrap(&self, raw: u16) -> Option<i64> {
+        self.started
+            .then(|| self.angle.wrapping_add(count_delta(raw, self.last) as i64))
+    }
 }

@@ -49,6 +49,12 @@ bitflags::bitflags! {
         const SENSOR_CASE = 1 << 2;
         /// The stored coefficients were refused: running on `ThermalCoeffs::SAFE`.
         const COEFFS_DEFAULT = 1 << 3;
+        /// Dithered gyro: no pickoff latch after the frame's instant, the
+        /// raw counter (dither included) stood in; or crossings were missed.
+        const NO_PICKOFF = 1 << 4;
+        /// Dithered gyro: a pickoff edge refused as implausible, or the
+        /// photodiodes too weak to place a latch within its count.
+        const LATCH_REFUSED = 1 << 5;
     }
 }
 
@@ -176,7 +182,7 @@ impl ThermalComp {
     pub fn bias_q16(&self) -> i64 {
         self.bias_q16
     }
-    /// Fault bits.
+    /// Fault bits (the sensor and coefficient ones).
     pub fn flags(&self) -> RlgFlags {
         self.flags
     }

@@ -36,6 +36,8 @@ pub enum BenchCmd {
     DiscoverHeldout(crate::cli::discover::bench::HeldOutBenchArgs),
     /// The online eps^2 correction over the vibration envelope: the table of issue 23.
     Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
+    /// The dithered RLG through the firmware's stripping: ARW against the physics, rate error through the lock-in zones.
+    Dither(crate::cli::bench_dither::DitherBenchArgs),
 }
 
 pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
@@ -48,6 +50,7 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
         BenchCmd::DiscoverHeldout(a) => crate::cli::discover::bench::discover_heldout(a),
         BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
+        BenchCmd::Dither(a) => crate::cli::bench_dither::run_bench(a),
     }
 }
 

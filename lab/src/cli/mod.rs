@@ -7,6 +7,7 @@ pub mod adev_plot;
 pub mod allan;
 pub mod args;
 pub mod bench;
+pub mod bench_dither;
 pub mod bench_eps2;
 pub mod bench_record;
 pub mod compensate;

@@ -2,6 +2,7 @@
 //! simulator.
 
 pub mod chamber;
+pub mod dither;
 pub mod fog;
 pub mod heldout;
 pub mod lockin;
@@ -19,6 +20,8 @@ pub enum SimulateCmd {
     Lockin(lockin::LockinSimArgs),
     /// RLG in a thermal chamber (writes a run file).
     Chamber(chamber::ChamberArgs),
+    /// Mechanically dithered RLG, counted and dither-stripped by the firmware's RLG core.
+    Dither(dither::DitherArgs),
     /// FOG scale-factor calibration run over temperature (continuous rotation or multi-point; writes a run file).
     ScaleFactor(scale_factor::SimulateArgs),
     /// A gyro model (model.toml) on a test profile with the project's noise: a run with known effects.
@@ -32,6 +35,7 @@ pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
         SimulateCmd::Fog(a) => fog::run(a),
         SimulateCmd::Lockin(a) => lockin::run(a),
         SimulateCmd::Chamber(a) => chamber::run(a),
+        SimulateCmd::Dither(a) => dither::run(a),
         SimulateCmd::ScaleFactor(a) => scale_factor::run(a),
         SimulateCmd::Run(a) => run::run(a),
         SimulateCmd::Heldout(a) => heldout::run(a),
