@@ -10,6 +10,25 @@ fn p(x: &std::path::Path) -> String {
     x.display().to_string()
 }
 
+/// `simulate run` of the table profile for an hour, with `extra` options.
+fn simulate(model: &std::path::Path, out: &std::path::Path, extra: &[&str]) {
+    let (m, o) = (p(model), p(out));
+    let mut args = vec![
+        "simulate",
+        "run",
+        "--model",
+        &m,
+        "--profile",
+        "table",
+        "--duration-s",
+        "3600",
+        "--out",
+        &o,
+    ];
+    args.extend_from_slice(extra);
+    lab_ok(&args);
+}
+
 fn term_model(formula: &str, params: &str) -> String {
     format!("kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n[[effect]]\nname = \"term\"\nformula = \"{formula}\"\n{params}\n")
 }
@@ -21,24 +40,15 @@ fn a_quadratic_rate_term_is_simulated_and_then_explained() {
     // 2e-4 deg/h per (deg/s)^2: 8 deg/h at the table's 200 deg/s.
     std::fs::write(&truth, term_model("k_dph * ref_rate_dps^2", "k_dph = 2e-4")).unwrap();
     let run = d.join("run.csv");
-    lab_ok(&[
-        "simulate",
-        "run",
-        "--model",
-        &p(&truth),
-        "--profile",
-        "table",
-        "--duration-s",
-        "3600",
+    let quiet = [
         "--arw-dpsh",
         "0",
         "--bias-instability-dph",
         "0",
         "--rate-random-walk-dphsh",
         "0",
-        "--out",
-        &p(&run),
-    ]);
+    ];
+    simulate(&truth, &run, &quiet);
     // Noise-free: every row is the reference plus the formula, deg/h.
     let text = std::fs::read_to_string(&run).unwrap();
     let mut rows = text.lines().filter(|l| !l.starts_with('#'));
@@ -55,18 +65,7 @@ fn a_quadratic_rate_term_is_simulated_and_then_explained() {
     assert!(n > 1000);
     // With noise, the truth given as the model leaves nothing to find.
     let noisy = d.join("noisy.csv");
-    lab_ok(&[
-        "simulate",
-        "run",
-        "--model",
-        &p(&truth),
-        "--profile",
-        "table",
-        "--duration-s",
-        "3600",
-        "--out",
-        &p(&noisy),
-    ]);
+    simulate(&truth, &noisy, &[]);
     let v = json(&lab_ok(&[
         "discover",
         "--gyro",

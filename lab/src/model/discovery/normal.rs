@@ -25,7 +25,14 @@ pub fn normal_solve(cols: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
         }
         b[i] = cols[i].iter().zip(y).map(|(p, q)| p * q).sum::<f64>() / norms[i];
     }
-    // Cholesky in place: a = L L'.
+    let z = cholesky_solve(a, &b, m)?;
+    Some(z.iter().zip(&norms).map(|(v, n)| v / n).collect())
+}
+
+/// Solves the symmetric positive definite `a` (m x m, row-major) z = b by
+/// Cholesky in place (a = L L'); None when a pivot falls below 1e-10 (the
+/// columns scaled to unit norm: collinear, or a column of zeros).
+pub fn cholesky_solve(mut a: Vec<f64>, b: &[f64], m: usize) -> Option<Vec<f64>> {
     for j in 0..m {
         let mut d = a[j * m + j];
         for k in 0..j {
@@ -44,7 +51,7 @@ pub fn normal_solve(cols: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
             a[i * m + j] = s / d;
         }
     }
-    let mut z = b;
+    let mut z = b.to_vec();
     for i in 0..m {
         for k in 0..i {
             z[i] -= a[i * m + k] * z[k];
@@ -57,7 +64,7 @@ pub fn normal_solve(cols: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
         }
         z[i] /= a[i * m + i];
     }
-    Some(z.iter().zip(&norms).map(|(v, n)| v / n).collect())
+    Some(z)
 }
 
 #[cfg(test)]

@@ -19,45 +19,10 @@ pub struct Projection {
     yy: f64,
 }
 
+use super::normal::cholesky_solve;
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(p, q)| p * q).sum()
-}
-
-/// Solves the symmetric positive definite `a` (m x m, row-major) z = b by
-/// Cholesky; None when a pivot falls below 1e-10 (normal.rs's rule).
-fn cholesky_solve(mut a: Vec<f64>, b: &[f64], m: usize) -> Option<Vec<f64>> {
-    for j in 0..m {
-        let mut d = a[j * m + j];
-        for k in 0..j {
-            d -= a[j * m + k] * a[j * m + k];
-        }
-        if d.is_nan() || d <= 1e-10 {
-            return None;
-        }
-        let d = d.sqrt();
-        a[j * m + j] = d;
-        for i in j + 1..m {
-            let mut s = a[i * m + j];
-            for k in 0..j {
-                s -= a[i * m + k] * a[j * m + k];
-            }
-            a[i * m + j] = s / d;
-        }
-    }
-    let mut z = b.to_vec();
-    for i in 0..m {
-        for k in 0..i {
-            z[i] -= a[i * m + k] * z[k];
-        }
-        z[i] /= a[i * m + i];
-    }
-    for i in (0..m).rev() {
-        for k in i + 1..m {
-            z[i] -= a[k * m + i] * z[k];
-        }
-        z[i] /= a[i * m + i];
-    }
-    Some(z)
 }
 
 impl Projection {
