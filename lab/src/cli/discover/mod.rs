@@ -207,6 +207,25 @@ pub fn json(d: &Discovery) -> serde_json::Value {
     })
 }
 
+/// The model's effects need columns the run at `path` has: else an error
+/// naming the first effect and what it lacks.
+fn computable(model: &Model, run: &Run, path: &Path) -> Result<(), LabError> {
+    match model.missing_inputs(&run.inputs).first() {
+        Some((e, cols)) => Err(LabError::input(
+            path,
+            format!(
+                "the model's effect `{}` needs column(s) {} that this run lacks",
+                e.name(),
+                cols.iter()
+                    .map(|c| format!("`{}`", c.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let t0 = std::time::Instant::now();
     let gyro = GyroKind::from(a.gyro);
@@ -224,19 +243,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
         None => Model::ideal(gyro),
     };
     // The model's own effects must be computable on this run.
-    if let Some((e, cols)) = model.missing_inputs(&data.inputs).first() {
-        return Err(LabError::input(
-            &a.data,
-            format!(
-                "the model's effect `{}` needs column(s) {} that this run lacks",
-                e.name(),
-                cols.iter()
-                    .map(|c| format!("`{}`", c.name()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        ));
-    }
+    computable(&model, &data, &a.data)?;
     let opts = Options {
         grade: a.grade.map(Grade::from),
     };
@@ -246,19 +253,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let validation = match &a.validate {
         Some(p) => {
             let v = read_run(p)?;
-            if let Some((e, cols)) = d.model_after.missing_inputs(&v.inputs).first() {
-                return Err(LabError::input(
-                    p,
-                    format!(
-                        "the model's effect `{}` needs column(s) {} that this run lacks",
-                        e.name(),
-                        cols.iter()
-                            .map(|c| format!("`{}`", c.name()))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                ));
-            }
+            computable(&d.model_after, &v, p)?;
             let opts_v = Options {
                 grade: Some(d.grade.value),
             };
