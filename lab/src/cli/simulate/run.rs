@@ -7,7 +7,7 @@ use crate::cli::model_file::read_model_file;
 use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
 use crate::data::run_file::{Column, RunWriter};
 use crate::error::LabError;
-use crate::sim::model_run::{generate, inputs_of, TestProfile, TrialNoise, TrialRun};
+use crate::sim::model_run::{generate, TestProfile, TrialNoise, TrialRun};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -152,10 +152,11 @@ pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
             .unwrap_or(nom.rate_random_walk_dphsh)
             .max(0.0),
     };
-    // A term must be computable on the profile's inputs before it is run.
-    file.check_terms(&inputs_of(profile, a.seed.seed, Some((dt, dur))))?;
     let model = &file.model;
     let run = generate(model, profile, noise, a.seed.seed, Some((dt, dur)));
+    // A term must be computable on the profile's inputs: refused at its
+    // place before anything is written (its rows would be NaN).
+    file.check_terms(&run.inputs)?;
     write(
         &run,
         &a.out.out,
