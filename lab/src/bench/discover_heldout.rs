@@ -56,10 +56,14 @@ fn names(v: &serde_json::Value) -> Vec<String> {
 /// Scores `r`, the JSON of `discover` on the run of `t`.
 pub fn score(t: &Truth, r: &serde_json::Value) -> Scored {
     let found = r["found"].as_array().cloned().unwrap_or_default();
+    // The library's names; a term outside it (issue 32) apart.
     let named: Vec<String> = found
         .iter()
         .filter_map(|f| f["effect"].as_str().map(str::to_owned))
+        .filter(|e| e != "term")
         .collect();
+    let terms = found.iter().filter(|f| f["effect"] == "term").count();
+    let outside = t.category == "outside the library";
     let ambiguous: Vec<Vec<String>> = r["ambiguous"]
         .as_array()
         .map(|a| a.iter().map(|g| names(&g["effects"])).collect())
@@ -91,9 +95,10 @@ pub fn score(t: &Truth, r: &serde_json::Value) -> Scored {
     let mut es = t.expect.clone();
     es.sort();
     let right = match t.category.as_str() {
-        "null, coloured noise" => named.is_empty(),
-        "outside the library" => named.is_empty() && unexplained,
-        _ => ns == es,
+        "null, coloured noise" => named.is_empty() && terms == 0,
+        // Said unexplained, or a term proposed for it.
+        "outside the library" => named.is_empty() && (unexplained || terms > 0),
+        _ => ns == es && terms == 0,
     };
     let gb = r["gap_before_dph"].as_f64().unwrap_or(f64::NAN);
     let ga = r["gap_after_dph"].as_f64().unwrap_or(f64::NAN);
@@ -101,7 +106,9 @@ pub fn score(t: &Truth, r: &serde_json::Value) -> Scored {
         name: t.name.clone(),
         category: t.category.clone(),
         expect: t.expect.clone(),
-        false_names: named.iter().filter(|n| !t.expect.contains(n)).count(),
+        // A term proposed where the truth holds none is a false name.
+        false_names: named.iter().filter(|n| !t.expect.contains(n)).count()
+            + if outside { 0 } else { terms },
         named,
         ambiguous,
         unexplained,

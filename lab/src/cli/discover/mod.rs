@@ -12,8 +12,9 @@ use crate::data::residual_file;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
 use crate::model::discovery::estimates::Estimate;
+use crate::model::discovery::outside::TermFound;
 use crate::model::discovery::terms::Kind;
-use crate::model::discovery::{discover, Discovery, Options, Run, WINDOW_S};
+use crate::model::discovery::{discover, discover_library, Discovery, Options, Run, WINDOW_S};
 use crate::model::effects::Effect;
 use crate::model::grade::Grade;
 use crate::model::gyro_kind::GyroKind;
@@ -133,10 +134,50 @@ fn estimate_json(e: &Estimate) -> serde_json::Value {
     })
 }
 
+/// A term outside the library's JSON (docs/interfaces.md): its formula,
+/// parameters with intervals, and how it was validated.
+fn term_json(t: &TermFound) -> serde_json::Value {
+    let intervals: BTreeMap<&str, [f64; 2]> = t
+        .intervals
+        .iter()
+        .map(|(k, v)| (k.as_str(), [v.0, v.1]))
+        .collect();
+    let v = &t.validation;
+    serde_json::json!({
+        "effect": "term",
+        "library": false,
+        "label": t.label,
+        "proposed": t.proposed,
+        "formula": t.term.formula,
+        "parameters": t.term.params,
+        "parameter_intervals": intervals,
+        "validation": {
+            "method": "blocked cross-validation on the whitened 1 s means: the coefficients fitted on all folds but one, the held-out fold predicted, in turn",
+            "folds": v.folds,
+            "held_out_gain": v.held_out_gain,
+            "fold_gains": v.fold_gains,
+            "threshold": v.threshold,
+            "held_out_share": v.held_out_share,
+            "passed": v.held_out_gain >= v.threshold,
+            "units": "noise variances of the whitened residual",
+        },
+        "disguise": t.disguise,
+        "gap_closed": t.closure.map(|c| serde_json::json!({
+            "gap_without_dph": c.0, "gap_with_dph": c.1, "excess_closed_share": c.2,
+        })),
+    })
+}
+
 /// The JSON of a discovery (docs/interfaces.md keys and more).
 pub fn json(d: &Discovery) -> serde_json::Value {
-    let found: Vec<serde_json::Value> = d.found.iter().map(estimate_json).collect();
-    let carried: Vec<serde_json::Value> = d
+    let mut found: Vec<serde_json::Value> = d.found.iter().map(estimate_json).collect();
+    found.extend(
+        d.terms
+            .iter()
+            .filter(|t| t.carried.is_none())
+            .map(term_json),
+    );
+    let mut carried: Vec<serde_json::Value> = d
         .carried
         .iter()
         .map(|c| {
@@ -145,6 +186,13 @@ pub fn json(d: &Discovery) -> serde_json::Value {
             j
         })
         .collect();
+    carried.extend(d.terms.iter().filter_map(|t| {
+        t.carried.as_ref().map(|why| {
+            let mut j = term_json(t);
+            j["why"] = why.clone().into();
+            j
+        })
+    }));
     let skipped: Vec<serde_json::Value> = d
         .skipped
         .iter()
@@ -191,6 +239,12 @@ pub fn json(d: &Discovery) -> serde_json::Value {
             })
             .collect::<Vec<_>>(),
         "skipped": skipped,
+        "proposal": {
+            "tried": d.proposals.tried.iter().take(12).map(|t| serde_json::json!({
+                "label": t.label, "formula": t.formula, "held_out_gain": t.held_out_gain,
+            })).collect::<Vec<_>>(),
+            "note": d.proposals.note,
+        },
         "disagreements": d.disagreements,
         "noise": {
             "white_1s_dph": n.white.sqrt() * 3600.0,
@@ -257,31 +311,105 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
             let opts_v = Options {
                 grade: Some(d.grade.value),
             };
-            Some((p.clone(), discover(&d.model_after, &v, &opts_v)))
+            // The model held as written (its terms not refitted): what
+            // it predicts of a run it was not fitted on.
+            let terms = second_run_terms(&d, &v);
+            Some((
+                p.clone(),
+                discover_library(&d.model_after, &v, &opts_v),
+                terms,
+            ))
         }
         None => None,
     };
     write_files(a, &d, &data)?;
     if a.json.json {
         let mut j = json(&d);
-        if let Some((p, v)) = &validation {
+        if let Some((p, v, terms)) = &validation {
             j["validation"] = validation_json(p, v);
+            let mut k = 0;
+            for f in j["found"].as_array_mut().into_iter().flatten() {
+                if f["effect"] == "term" {
+                    if let Some(t) = terms.get(k) {
+                        f["validation"]["second_run"] = t.json(p);
+                    }
+                    k += 1;
+                }
+            }
         }
         j["elapsed_s"] = t0.elapsed().as_secs_f64().into();
         println!("{j}");
         return Ok(());
     }
     print_text(a, &d);
-    if let Some((p, v)) = &validation {
+    if let Some((p, v, terms)) = &validation {
         print_validation(p, v);
+        for (t, s) in d.terms.iter().filter(|t| t.carried.is_none()).zip(terms) {
+            println!(
+                "  the term {} on {}: the gap (bias removed) {:.4} deg/h with it, {:.4} without: {}",
+                t.term.formula,
+                p.display(),
+                s.with_dph,
+                s.without_dph,
+                if s.with_dph < s.without_dph { "it predicts that run" } else { "it does NOT predict that run" }
+            );
+        }
     }
     Ok(())
+}
+
+/// A named term judged on a second run: the gap of the model written with
+/// and without it, each with its mean removed (the bias may change from
+/// run to run), deg/h.
+struct SecondRun {
+    with_dph: f64,
+    without_dph: f64,
+}
+
+impl SecondRun {
+    fn json(&self, path: &Path) -> serde_json::Value {
+        serde_json::json!({
+            "data": path,
+            "gap_with_term_dph": self.with_dph,
+            "gap_without_term_dph": self.without_dph,
+            "predicts": self.with_dph < self.without_dph,
+        })
+    }
+}
+
+/// [`SecondRun`] of each named term of `d`'s model on `v`.
+fn second_run_terms(d: &Discovery, v: &Run) -> Vec<SecondRun> {
+    let win = crate::model::discovery::windows::Windows::new(&v.inputs.t, WINDOW_S);
+    let gap = |m: &Model| -> f64 {
+        let sim = m.evaluate(&v.inputs);
+        let r: Vec<f64> = v.rate.iter().zip(&sim).map(|(a, b)| a - b).collect();
+        let w = win.mean(&r);
+        let n = w.len().max(1) as f64;
+        let mean = w.iter().sum::<f64>() / n;
+        (w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() * 3600.0
+    };
+    let with = gap(&d.model_after);
+    d.terms
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.carried.is_none())
+        .map(|(i, _)| {
+            let mut m = d.model_after.clone();
+            m.terms.remove(i);
+            SecondRun {
+                with_dph: with,
+                without_dph: gap(&m),
+            }
+        })
+        .collect()
 }
 
 /// Whether the model written predicts another run of the same gyro: there
 /// it needs nothing more than a bias, and leaves nothing unexplained.
 pub fn predicts(v: &Discovery) -> bool {
-    v.found.iter().all(|e| e.effect == Effect::Bias) && v.unexplained.is_none()
+    v.found.iter().all(|e| e.effect == Effect::Bias)
+        && !v.terms.iter().any(|t| t.proposed && t.carried.is_none())
+        && v.unexplained.is_none()
 }
 
 /// The JSON of the validation run: the model written, on it.
@@ -344,7 +472,13 @@ fn run_extent(data: &Run) -> Extent {
 fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabError> {
     let out = &a.out.out;
     std::fs::create_dir_all(out).map_err(|e| LabError::io(out, e))?;
-    let names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
+    let mut names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
+    names.extend(
+        d.terms
+            .iter()
+            .filter(|t| t.proposed && t.carried.is_none())
+            .map(|t| t.term.formula.as_str()),
+    );
     let carried: Vec<String> = d
         .carried
         .iter()
@@ -374,6 +508,18 @@ fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabErr
     )?;
     write_report(&report::report(d, data, &a.data), &out.join("report.html"))?;
     Ok(())
+}
+
+fn term_params_text(t: &TermFound) -> String {
+    t.term
+        .params
+        .iter()
+        .map(|(n, v)| match t.intervals.get(n) {
+            Some((lo, hi)) => format!("{n} {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi)),
+            None => format!("{n} {}", sig(*v)),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn params_text(e: &Estimate) -> String {
@@ -416,6 +562,25 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
             e.delta_bic,
             100.0 * e.explained_share
         );
+    }
+    for t in &d.terms {
+        let ps = term_params_text(t);
+        match &t.carried {
+            None => println!(
+                "found term{} {} ({}): {ps}; it predicts blocks of the record it was not fitted on by {:.1} noise variances (threshold {}, {} folds){}",
+                if t.proposed { ", a proposal outside the physics library:" } else { " written in the model:" },
+                t.term.formula,
+                t.label,
+                t.validation.held_out_gain,
+                t.validation.threshold,
+                t.validation.folds,
+                t.disguise.as_ref().map_or(String::new(), |g| format!("; it is {g}"))
+            ),
+            Some(why) => println!("carried term {}: {ps} ({why})", t.term.formula),
+        }
+    }
+    if let Some(n) = &d.proposals.note {
+        println!("proposal: {n}");
     }
     for c in &d.carried {
         println!(
@@ -484,7 +649,7 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
                 .collect();
             println!("  it follows most: {}", c.join(", "));
         }
-        None if d.found.is_empty() && d.ambiguous.is_empty() => {
+        None if d.found.is_empty() && d.ambiguous.is_empty() && d.terms.is_empty() => {
             println!("nothing is missing: no effect of the library beats the noise, and nothing stands out of it");
         }
         None => {}

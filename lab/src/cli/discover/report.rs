@@ -176,6 +176,98 @@ fn found_section(r: &mut Report, d: &Discovery) {
     }
 }
 
+/// The terms outside the library: each against the residual it explains,
+/// said plainly to be a proposal, with its evidence.
+fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
+    if d.terms.is_empty() && d.proposals.tried.is_empty() {
+        return;
+    }
+    r.heading("Terms outside the physics library");
+    let win = &d.windows;
+    let after = win.mean(&d.residual_after);
+    for t in &d.terms {
+        let what = if t.proposed {
+            format!(
+                "A proposal outside the physics library: {} ({}), built from the run's own inputs because no \
+                 library effect explained what the residual held. It is not a named physical effect: it is the \
+                 simplest candidate that predicts data it was not fitted on.",
+                t.term.formula, t.label
+            )
+        } else {
+            format!(
+                "Written in the model given: {} (its parameters fitted here).",
+                t.term.formula
+            )
+        };
+        r.paragraph(&what);
+        let params: Vec<String> = t
+            .term
+            .params
+            .iter()
+            .map(|(k, v)| match t.intervals.get(k) {
+                Some((lo, hi)) => format!("{k} = {} [{} .. {}]", sig(*v), sig(*lo), sig(*hi)),
+                None => format!("{k} = {}", sig(*v)),
+            })
+            .collect();
+        let v = &t.validation;
+        let worst = v.fold_gains.iter().copied().fold(f64::INFINITY, f64::min);
+        r.table(
+            &["parameters (95 % interval)", "validation", "status"],
+            &[vec![
+                params.join("; "),
+                format!(
+                    "blocked cross-validation, {} folds: fitted on the others, each fold predicted; held-out gain {} \
+                     noise variances (threshold {}; worst fold {}), {} % of the whitened residual",
+                    v.folds,
+                    sig(v.held_out_gain),
+                    sig(v.threshold),
+                    sig(worst),
+                    sig(100.0 * v.held_out_share)
+                ),
+                t.carried.clone().unwrap_or_else(|| "named".into()),
+            ]],
+        );
+        if let Some(g) = &t.disguise {
+            r.note(&format!("A known shape in disguise: this term is {g}."));
+        }
+        let Ok(c) = t.term.evaluate(&run.inputs) else {
+            continue;
+        };
+        let cw: Vec<f64> = win.mean(&c);
+        // The residual the term explains: after the model, the term put back.
+        let partial: Vec<f64> = after.iter().zip(&cw).map(|(a, b)| a * DPH + b).collect();
+        r.plot(
+            &Axes {
+                title: format!("{}: the term against the residual it explains", t.term.formula),
+                x_label: "time since power-on, s".into(),
+                y_label: "deg/h".into(),
+                log_x: false,
+                log_y: false,
+            },
+            &[
+                Series::points("residual with the term put back, 1 s means", thin(&win.t, &partial), None, 0),
+                Series::line("the term", thin(&win.t, &cw), 1),
+            ],
+            "The residual after the model with this term's contribution added back (points), and the term (line): \
+             where the term is what was missing the points scatter about the line by the noise alone.",
+        );
+    }
+    if !d.proposals.tried.is_empty() {
+        let rows: Vec<Vec<String>> = d
+            .proposals
+            .tried
+            .iter()
+            .take(8)
+            .map(|c| vec![c.label.to_string(), c.formula.clone(), sig(c.held_out_gain)])
+            .collect();
+        r.paragraph("The candidates tried last, best first (held-out gain in noise variances of the whitened residual):");
+        r.table(&["candidate", "formula", "held-out gain"], &rows);
+    }
+    if let Some(n) = &d.proposals.note {
+        r.note(n);
+    }
+}
+
 /// What no effect of the library explains.
 fn unexplained_section(r: &mut Report, d: &Discovery) {
     r.heading("Unexplained");
@@ -325,7 +417,11 @@ fn ambiguous_and_skipped(r: &mut Report, d: &Discovery) {
 fn verdict(d: &Discovery) -> Verdict {
     let mut v = Verdict::new();
     if d.found.is_empty() {
-        v.text("Nothing is named. ");
+        v.text(if d.terms.iter().any(|t| t.carried.is_none()) {
+            "No effect of the library is named. "
+        } else {
+            "Nothing is named. "
+        });
     } else {
         v.text("Found ");
         for (i, e) in d.found.iter().enumerate() {
@@ -348,6 +444,22 @@ fn verdict(d: &Discovery) -> Verdict {
             }
         }
         v.text(". ");
+    }
+    let named_terms: Vec<&str> = d
+        .terms
+        .iter()
+        .filter(|t| t.carried.is_none())
+        .map(|t| t.term.formula.as_str())
+        .collect();
+    if !named_terms.is_empty() {
+        v.text(&format!(
+            "Added outside the physics library (a proposal, validated on blocks of the record it was not fitted on): {}. ",
+            named_terms.join("; ")
+        ));
+        v.warning(
+            "proposal",
+            "a term outside the physics library is in the model written: it predicts the data, but it is not a named physical effect",
+        );
     }
     v.text("The gap (RMS of 1 s means of measured - model) went from ")
         .num("gap_before_dph", d.gap_before_dph, 4)
@@ -436,6 +548,7 @@ pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
     residual_section(&mut r, d);
     allan_section(&mut r, d);
     found_section(&mut r, d);
+    terms_section(&mut r, d, run);
     unexplained_section(&mut r, d);
     effect_plots(&mut r, d, run);
     ambiguous_and_skipped(&mut r, d);

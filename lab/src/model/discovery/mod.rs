@@ -26,6 +26,7 @@ pub mod likelihood;
 pub mod noise_floor;
 pub mod noise_model;
 pub mod normal;
+pub mod outside;
 pub mod projection;
 pub mod select;
 pub mod terms;
@@ -136,6 +137,12 @@ pub struct Discovery {
     pub model_after: Model,
     pub allan_before: Option<Allan>,
     pub allan_after: Option<Allan>,
+    /// The windows the final fit used (transients left out).
+    pub keep: Vec<bool>,
+    /// The model's terms outside the library (outside.rs): a user's,
+    /// fitted, and those proposed.
+    pub terms: Vec<outside::TermFound>,
+    pub proposals: outside::Proposals,
 }
 
 /// Measured minus the model's output, deg/s.
@@ -458,9 +465,18 @@ fn window_spacing(win: &Windows) -> f64 {
     d[d.len() / 2]
 }
 
-/// What `model` misses of `run`: the effects found, the model with them
-/// added, the residual before and after, and what stays unexplained.
+/// What `model` misses of `run`: the effects found, the terms outside the
+/// library (a user's fitted, one proposed where the library leaves the
+/// residual unexplained), the model with them added, the residual before
+/// and after, and what stays unexplained.
 pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
+    let first = discover_library(model, run, opts);
+    outside::beyond(model, run, opts, first)
+}
+
+/// [`discover`] with the library's effects alone (the model's terms held
+/// as given).
+pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let inp = &run.inputs;
     let r = residual(model, run);
     let win = Windows::new(&inp.t, WINDOW_S);
@@ -711,6 +727,8 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
         unexplained = Some(unexplained::beyond_floor(&d, &noise, &after_w, excess, why));
     }
     let allan_after = allan_of(&inp.t, &r_after);
+    let keep = d.wh.keep.clone();
+    drop(d);
     Discovery {
         gyro: model.gyro,
         grade,
@@ -738,5 +756,8 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
         model_after,
         allan_before,
         allan_after,
+        keep,
+        terms: vec![],
+        proposals: Default::default(),
     }
 }

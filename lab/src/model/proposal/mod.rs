@@ -15,6 +15,7 @@
 //! noise cannot already predict.
 
 pub mod candidates;
+pub mod refit;
 pub mod validation;
 
 use crate::model::inputs::Inputs;
@@ -67,7 +68,7 @@ pub struct Proposal {
 
 /// Unit vectors spanning `cols` (modified Gram-Schmidt; dependent columns
 /// dropped).
-fn basis(cols: &[Vec<f64>]) -> Vec<Vec<f64>> {
+pub(crate) fn basis(cols: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let mut q: Vec<Vec<f64>> = vec![];
     for c in cols {
         let mut v = c.clone();
@@ -85,7 +86,7 @@ fn basis(cols: &[Vec<f64>]) -> Vec<Vec<f64>> {
     q
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -116,6 +117,10 @@ fn columns(
         })
         .collect()
 }
+
+/// Values of a searched parameter tried between the coarse grid's
+/// neighbours of its best.
+const REFINE: usize = 40;
 
 /// A candidate with its statistics at each value of its searched
 /// parameter kept, the values, its held-out gain and its folds' gains.
@@ -182,6 +187,30 @@ pub fn propose(
         .filter(|s| s.3 >= 0.97 * top && s.3 / var >= THRESHOLD)
         .min_by_key(|s| s.0.freedom());
     let proposed = pick.and_then(|(c, grid, kept, gain, folds)| {
+        // The searched parameter refined between the coarse grid's
+        // neighbours of its best value, so its value and profile interval
+        // are not the grid's.
+        let mut grid = grid.clone();
+        let mut kept = kept.clone();
+        let coarse_best = grid
+            .iter()
+            .enumerate()
+            .filter_map(|(i, g)| g.fit(None).map(|f| (i, f.1)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|b| b.0);
+        if let (Some(b), Some(_)) = (coarse_best, &c.searched) {
+            let lo = kept[b.saturating_sub(1)];
+            let hi = kept[(b + 1).min(kept.len() - 1)];
+            if let (Some(lo), Some(hi)) = (lo, hi) {
+                for k in 1..REFINE {
+                    let v = lo + (hi - lo) * k as f64 / REFINE as f64;
+                    if let Some(cols) = columns(c, Some(v), inp, to_rows, &q) {
+                        grid.push(stats(&cols, y, FOLDS));
+                        kept.push(Some(v));
+                    }
+                }
+            }
+        }
         let fits: Vec<(usize, Vec<f64>, f64)> = grid
             .iter()
             .enumerate()
@@ -204,16 +233,25 @@ pub fn propose(
             );
         }
         if let (Some(s), Some(v)) = (&c.searched, kept[i]) {
-            // Profile: the values whose fit is within chi2(1, 95 %) of the best.
+            // Profile: the values whose fit is within chi2(1, 95 %) of the
+            // best, widened by the spacing of the values tried about them.
             let ok: Vec<f64> = fits
                 .iter()
                 .filter(|f| red - f.2 <= 3.84 * var)
                 .filter_map(|f| kept[f.0])
                 .collect();
+            let mut all: Vec<f64> = kept.iter().flatten().copied().collect();
+            all.sort_by(f64::total_cmp);
+            let step_at = |x: f64| -> f64 {
+                let k = all.partition_point(|&a| a < x);
+                let below = if k > 0 { x - all[k - 1] } else { 0.0 };
+                let above = all.get(k + 1).map_or(0.0, |a| a - x);
+                below.max(above)
+            };
             let lo = ok.iter().copied().fold(v, f64::min);
             let hi = ok.iter().copied().fold(v, f64::max);
             params.insert(s.name.to_string(), v);
-            intervals.insert(s.name.to_string(), (lo, hi));
+            intervals.insert(s.name.to_string(), (lo - step_at(lo), hi + step_at(hi)));
         }
         let term = Term::new(&c.formula(), params).ok()?;
         Some(Proposed {

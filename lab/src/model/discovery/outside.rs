@@ -1,0 +1,439 @@
+//! Beyond the library (issue 32): the terms of the model file that are
+//! not library effects. A user's term written by hand has its parameters
+//! fitted; where the library leaves the residual unexplained, a term built
+//! from the run's own inputs is proposed (model/proposal/), validated on
+//! blocks of the record it was not fitted on, added to the model, and the
+//! library's selection run again with it in place, so the effects are
+//! named beside the term as they would be had the library held it.
+//!
+//! A proposal is kept only where the gap after shrinks with it; the gap
+//! before stays the model given's.
+
+use super::noise_model::Whitener;
+use super::select::Implausible;
+use super::{discover_library, Discovery, Options, Run};
+use crate::model::effects::Effect;
+use crate::model::gyro_model::Model;
+use crate::model::inputs::Inputs;
+use crate::model::proposal::refit::{fit_term, is_linear};
+use crate::model::proposal::{propose, Tried, Validation};
+use crate::model::term::Term;
+use std::collections::BTreeMap;
+
+/// Most terms proposed on one run.
+pub const MAX_PROPOSED: usize = 2;
+
+/// A term is proposed only where the gap after the library stands at
+/// least this many times above the noise floor: below it, what is left is
+/// as much an imperfect library effect or noise model (a sensor's lag, a
+/// flicker at the floor) as a missing term, and a term would be named
+/// for a few percent of the gap.
+pub const MIN_GAP_OVER_FLOOR: f64 = 1.5;
+
+/// The least share of the gap's excess over the noise floor (in variance)
+/// a proposed term must close.
+pub const MIN_CLOSED: f64 = 0.5;
+
+/// A term of the model written that is not a library effect.
+#[derive(Clone, Debug)]
+pub struct TermFound {
+    /// What a gyro engineer would call it ("written in the model" for a
+    /// user's own).
+    pub label: String,
+    pub term: Term,
+    /// 95 % intervals of its parameters.
+    pub intervals: BTreeMap<String, (f64, f64)>,
+    pub validation: Validation,
+    /// Proposed by discover; false: written in the model given.
+    pub proposed: bool,
+    /// Why it is carried and not named (None: named).
+    pub carried: Option<String>,
+    /// The library effect whose shape it is, with what keeps that effect
+    /// from being named.
+    pub disguise: Option<String>,
+    /// A proposed term's effect on the gap after: without it, with it
+    /// (deg/h), and the share of the excess over the floor it closed.
+    pub closure: Option<(f64, f64, f64)>,
+}
+
+/// What the proposal tried on the run (the last attempt), and why it
+/// stopped where it did.
+#[derive(Clone, Debug, Default)]
+pub struct Proposals {
+    pub tried: Vec<Tried>,
+    pub note: Option<String>,
+}
+
+/// The whitened rows of per-row columns in deg/h, under `d`'s noise.
+struct Rows<'a> {
+    d: &'a Discovery,
+    wh: Whitener,
+}
+
+impl<'a> Rows<'a> {
+    fn new(d: &'a Discovery) -> Self {
+        Self {
+            wh: Whitener::new(&d.noise, &d.windows, &d.keep),
+            d,
+        }
+    }
+    fn dph(&self, x: &[f64]) -> Vec<f64> {
+        let s: Vec<f64> = x.iter().map(|v| v / 3600.0).collect();
+        self.wh.whiten(&self.d.windows.mean(&s))
+    }
+    fn dps(&self, x: &[f64]) -> Vec<f64> {
+        self.wh.whiten(&self.d.windows.mean(x))
+    }
+}
+
+/// The whitened columns the discovery's fit carries: the constant, every
+/// parameter of the effects it added to `given`, and every parameter of
+/// the model's terms but term `skip`.
+fn fit_columns(
+    given: &Model,
+    d: &Discovery,
+    inp: &Inputs,
+    rows: &Rows,
+    skip: Option<usize>,
+) -> Vec<Vec<f64>> {
+    let mut cols = vec![rows.dps(&vec![1.0; inp.len()])];
+    for e in d.model_after.effects.iter().skip(given.effects.len()) {
+        let c0 = e.effect.contribution(inp, &e.params);
+        for (p, &v) in &e.params {
+            let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
+            let mut q = e.params.clone();
+            q.insert(p.clone(), v + h);
+            let c1 = e.effect.contribution(inp, &q);
+            let col: Vec<f64> = c1.iter().zip(&c0).map(|(a, b)| (a - b) / h).collect();
+            cols.push(rows.dps(&col));
+        }
+    }
+    for (i, t) in d.model_after.terms.iter().enumerate() {
+        if Some(i) == skip {
+            continue;
+        }
+        let Ok(g0) = t.evaluate(inp) else { continue };
+        for (p, &v) in &t.params {
+            let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
+            let mut u = t.clone();
+            u.params.insert(p.clone(), v + h);
+            if let Ok(g1) = u.evaluate(inp) {
+                let col: Vec<f64> = g1.iter().zip(&g0).map(|(a, b)| (a - b) / h).collect();
+                cols.push(rows.dph(&col));
+            }
+        }
+    }
+    cols
+}
+
+/// Term `i` of `d`'s model fitted on `d`'s residual (its other terms and
+/// effects carried), `free` its parameters let move.
+fn refit(
+    given: &Model,
+    d: &Discovery,
+    run: &Run,
+    i: usize,
+    free: &[String],
+) -> Option<crate::model::proposal::refit::TermFit> {
+    let inp = &run.inputs;
+    let rows = Rows::new(d);
+    let t = &d.model_after.terms[i];
+    let mut y = rows.dps(&d.residual_after);
+    let own = rows.dph(&t.evaluate(inp).ok()?);
+    y.iter_mut().zip(&own).for_each(|(a, b)| *a += b);
+    let fit = fit_columns(given, d, inp, &rows, Some(i));
+    fit_term(t, free, inp, &y, &fit, &|x| rows.dph(x))
+}
+
+/// The parameters of a term refitted: all of a user's; a proposed term's
+/// coefficients (its searched shape parameter keeps the value and the
+/// profile interval its search gave).
+fn free_params(t: &Term, proposed: bool, inp: &Inputs) -> Vec<String> {
+    t.params
+        .keys()
+        .filter(|p| !proposed || is_linear(t, p, inp))
+        .cloned()
+        .collect()
+}
+
+/// Pearson correlation.
+fn corr(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()) as f64;
+    if n < 3.0 {
+        return 0.0;
+    }
+    let ma = a.iter().sum::<f64>() / n;
+    let mb = b.iter().sum::<f64>() / n;
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    if saa <= 0.0 || sbb <= 0.0 {
+        return 0.0;
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+/// The library effect `t` is the shape of, if any: an effect the first
+/// selection fitted but found implausible, or one the library holds for
+/// another kind of gyro, whose 1 s means follow the term's to 0.95.
+fn disguise(t: &Term, d: &Discovery, implausible: &[Implausible], inp: &Inputs) -> Option<String> {
+    let g = d.windows.mean(&t.evaluate(inp).ok()?);
+    for i in implausible {
+        let params: BTreeMap<String, f64> = i.parameters.iter().cloned().collect();
+        let c = d.windows.mean(&i.effect.contribution(inp, &params));
+        if corr(&g, &c).abs() >= 0.95 {
+            let out: Vec<String> = i
+                .outside
+                .iter()
+                .map(|(k, v, r)| {
+                    format!(
+                        "{k} {} outside {} .. {}",
+                        crate::report::text::sig(*v),
+                        crate::report::text::sig(r.0),
+                        crate::report::text::sig(r.1)
+                    )
+                })
+                .collect();
+            return Some(format!(
+                "the shape of the library's {}, with {} for a {} gyro: the library's effect at an implausible value",
+                i.effect.name(),
+                out.join(", "),
+                d.grade.value
+            ));
+        }
+    }
+    for e in Effect::ALL {
+        if e.applies_to(d.gyro) || !e.available(inp) || e.nonlinear_param().is_some() {
+            continue;
+        }
+        for col in e.basis(inp, 0.0).cols {
+            if corr(&g, &d.windows.mean(&col)).abs() >= 0.95 {
+                let kinds: Vec<&str> = [
+                    crate::model::gyro_kind::GyroKind::Fog,
+                    crate::model::gyro_kind::GyroKind::Rlg,
+                    crate::model::gyro_kind::GyroKind::Mems,
+                ]
+                .into_iter()
+                .filter(|k| e.applies_to(*k))
+                .map(|k| k.name())
+                .collect();
+                return Some(format!(
+                    "the shape of the library's {}, which the library holds for the {} only",
+                    e.name(),
+                    kinds.join(" and ")
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// Whether every coefficient's interval excludes zero.
+fn significant(t: &Term, intervals: &BTreeMap<String, (f64, f64)>, inp: &Inputs) -> bool {
+    let lin: Vec<&String> = t.params.keys().filter(|p| is_linear(t, p, inp)).collect();
+    !lin.is_empty()
+        && lin.iter().any(|p| {
+            intervals
+                .get(*p)
+                .is_some_and(|(lo, hi)| *lo > 0.0 || *hi < 0.0)
+        })
+}
+
+/// The user's terms refitted on `cur` until the library's selection no
+/// longer moves them (twice at most); a refit is kept where the gap after
+/// does not grow.
+fn refit_users(
+    given: &Model,
+    mut m: Model,
+    mut cur: Discovery,
+    run: &Run,
+    opts: &Options,
+    users: usize,
+) -> (Model, Discovery) {
+    for _ in 0..2 {
+        let mut next_m = m.clone();
+        let mut moved = false;
+        for i in 0..users {
+            let free = free_params(&cur.model_after.terms[i], false, &run.inputs);
+            if let Some(f) = refit(given, &cur, run, i, &free) {
+                moved |= f.term.params != next_m.terms[i].params;
+                next_m.terms[i] = f.term;
+            }
+        }
+        if !moved {
+            break;
+        }
+        let next = discover_library(&next_m, run, opts);
+        if next.gap_after_dph > cur.gap_after_dph {
+            break;
+        }
+        (m, cur) = (next_m, next);
+    }
+    (m, cur)
+}
+
+/// Discovery with the terms beyond the library: `first` is the library's
+/// discovery on `given`.
+pub fn beyond(given: &Model, run: &Run, opts: &Options, mut first: Discovery) -> Discovery {
+    let inp = &run.inputs;
+    if first.short.is_some() {
+        return first;
+    }
+    let users = given.terms.len();
+    // What the model given leaves, kept for the discovery's 'before'.
+    let implausible = first.implausible.clone();
+    let gap_before = first.gap_before_dph;
+    let residual_before = first.residual_before.clone();
+    let allan_before = first.allan_before.take();
+    let disagreements = std::mem::take(&mut first.disagreements);
+    let (mut m, mut cur) = if users > 0 {
+        refit_users(given, given.clone(), first, run, opts, users)
+    } else {
+        (given.clone(), first)
+    };
+    // Proposals: what they were, with their validation.
+    let mut proposed: Vec<(String, BTreeMap<String, (f64, f64)>, Validation)> = vec![];
+    let mut log = Proposals::default();
+    // Per proposed term: the gap after without and with it, and the share
+    // of the excess above the floor it closed.
+    let mut closure: Vec<(f64, f64, f64)> = vec![];
+    while cur.unexplained.is_some() && proposed.len() < MAX_PROPOSED {
+        if cur.gap_after_dph < MIN_GAP_OVER_FLOOR * cur.noise_floor_dph {
+            log.note = Some(format!(
+                "the gap after the model, {:.4} deg/h, is less than {MIN_GAP_OVER_FLOOR} times the noise floor ({:.4} deg/h): what stands above the floor is too little to propose a term for",
+                cur.gap_after_dph, cur.noise_floor_dph
+            ));
+            break;
+        }
+        let rows = Rows::new(&cur);
+        let y = rows.dps(&cur.residual_after);
+        let fit = fit_columns(given, &cur, inp, &rows, None);
+        let p = propose(inp, &y, &fit, &|x| rows.dph(x));
+        log.tried = p.tried;
+        let Some(pr) = p.proposed else {
+            log.note = Some(match log.tried.first() {
+                Some(b) => format!(
+                    "no term built from the run's inputs predicts what is left on data it was not fitted on: the best, {} ({}), gains {:.1} noise variances out of sample, below the {} the candidate space's false alarms ask",
+                    b.label, b.formula, b.held_out_gain, crate::model::proposal::validation::THRESHOLD
+                ),
+                None => "the run's inputs give no candidate term".into(),
+            });
+            break;
+        };
+        let mut m2 = m.clone();
+        m2.terms.push(pr.term.clone());
+        let next = discover_library(&m2, run, opts);
+        // What stood above the floor, and what of it the term closed: a
+        // term that predicts a little of a residual it cannot explain (a
+        // slow wander the noise model misread) is not the missing effect.
+        let floor = cur.noise_floor_dph.min(next.noise_floor_dph);
+        let excess = |g: f64| (g * g - floor * floor).max(0.0);
+        let closed = 1.0 - excess(next.gap_after_dph) / excess(cur.gap_after_dph).max(1e-300);
+        if next.gap_after_dph < cur.gap_after_dph && closed < MIN_CLOSED {
+            log.note = Some(format!(
+                "{} ({}) predicted blocks of the record it was not fitted on, but closed only {:.0} % of what stood above the noise floor ({:.4} -> {:.4} deg/h, floor {:.4}), less than the {:.0} % that makes it the missing effect: not added",
+                pr.label,
+                pr.term.formula,
+                100.0 * closed,
+                cur.gap_after_dph,
+                next.gap_after_dph,
+                floor,
+                100.0 * MIN_CLOSED
+            ));
+            break;
+        }
+        if next.gap_after_dph >= cur.gap_after_dph {
+            log.note = Some(format!(
+                "{} ({}) predicted blocks of the record it was not fitted on, but with the library's effects fitted again beside it the gap after did not shrink ({:.4} -> {:.4} deg/h): not added",
+                pr.label,
+                pr.term.formula,
+                cur.gap_after_dph,
+                next.gap_after_dph
+            ));
+            break;
+        }
+        closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
+        proposed.push((pr.label.to_string(), pr.intervals, pr.validation));
+        (m, cur) = (m2, next);
+    }
+    // Every term's final values, intervals and validation, beside the
+    // effects named with it.
+    let mut found = vec![];
+    for i in 0..cur.model_after.terms.len() {
+        let is_proposed = i >= users;
+        let t = cur.model_after.terms[i].clone();
+        let free = free_params(&t, is_proposed, inp);
+        let fitted = refit(given, &cur, run, i, &free);
+        let (label, mut intervals, validation) = if is_proposed {
+            let (l, iv, v) = proposed[i - users].clone();
+            (l, iv, v)
+        } else {
+            match &fitted {
+                Some(f) => (
+                    "written in the model".to_string(),
+                    f.intervals.clone(),
+                    f.validation.clone(),
+                ),
+                None => (
+                    "written in the model".to_string(),
+                    BTreeMap::new(),
+                    Validation {
+                        folds: 0,
+                        held_out_gain: f64::NAN,
+                        fold_gains: vec![],
+                        threshold: crate::model::proposal::validation::THRESHOLD,
+                        held_out_share: f64::NAN,
+                    },
+                ),
+            }
+        };
+        if let Some(f) = &fitted {
+            // The coefficients' intervals beside the effects named with
+            // the term (the value is the one the model carries).
+            for p in &free {
+                if let (Some(iv), Some(v)) = (f.intervals.get(p), t.params.get(p)) {
+                    let half = 0.5 * (iv.1 - iv.0);
+                    intervals.insert(p.clone(), (v - half, v + half));
+                }
+            }
+        }
+        let carried = if !significant(&t, &intervals, inp) {
+            Some(format!("not named: {}", super::NOT_SIGNIFICANT))
+        } else if !(validation.held_out_gain >= validation.threshold) {
+            Some(format!(
+                "not named: refitted on blocks of the record, it predicts the others by {:.1} noise variances, below the threshold of {}",
+                validation.held_out_gain, validation.threshold
+            ))
+        } else {
+            None
+        };
+        let disguise = if is_proposed {
+            disguise(&t, &cur, &implausible, inp)
+        } else {
+            None
+        };
+        found.push(TermFound {
+            label,
+            term: t,
+            intervals,
+            validation,
+            proposed: is_proposed,
+            carried,
+            disguise,
+            closure: is_proposed.then(|| closure[i - users]),
+        });
+    }
+    let mut out = cur;
+    out.terms = found;
+    out.proposals = log;
+    // The gap before, its residual and where it disagreed: the model
+    // given's.
+    out.gap_before_dph = gap_before;
+    out.residual_before = residual_before;
+    out.allan_before = allan_before;
+    out.disagreements = disagreements;
+    out
+}
