@@ -13,6 +13,7 @@ use super::windows::Windows;
 use crate::model::effects::{Effect, DPH};
 use crate::model::inputs::Inputs;
 use crate::model::ranges::Extent;
+use crate::numerics::dot::sum_sq;
 use crate::numerics::search::{golden, grid_then_golden};
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
@@ -50,6 +51,23 @@ pub struct Design<'a> {
     /// the bytes they hold (at most [`GRID_CACHE_BYTES`]).
     grid_cache: RefCell<HashMap<(String, u64), Rc<Whitened>>>,
     grid_bytes: Cell<usize>,
+    /// Whitened columns of terms off their grid: the golden-section
+    /// searches come back to the same points while the other terms hold
+    /// still, and a selection fits the same set again and again (at most
+    /// [`OFF_GRID_CACHE_BYTES`], emptied when full).
+    off_grid: RefCell<HashMap<(String, u64), Rc<Whitened>>>,
+    off_grid_bytes: Cell<usize>,
+}
+
+/// Grid points whitened together.
+const WHITEN_TERMS: usize = 8;
+
+/// Memory the whitened columns off the grid may take.
+const OFF_GRID_CACHE_BYTES: usize = 128 << 20;
+
+/// Bytes a term's whitened columns take.
+fn bytes_of(w: &Whitened) -> usize {
+    8 * (w.0.iter().map(Vec::len).sum::<usize>() + w.1.as_ref().map_or(0, Vec::len))
 }
 
 /// Memory the grid's whitened columns may take.
@@ -66,7 +84,6 @@ const REFINE_STEPS: usize = 30;
 enum WRef<'a> {
     Held(&'a Whitened),
     Shared(Rc<Whitened>),
-    Owned(Whitened),
 }
 
 impl WRef<'_> {
@@ -74,7 +91,6 @@ impl WRef<'_> {
         match self {
             WRef::Held(w) => w,
             WRef::Shared(w) => w,
-            WRef::Owned(w) => w,
         }
     }
 }
@@ -105,20 +121,21 @@ impl<'a> Design<'a> {
         wh: Whitener,
         steps: Vec<f64>,
     ) -> Self {
-        let y = wh.whiten(&r);
         let mut d = Self {
             inp,
             win,
             extent,
             r,
             wh,
-            y,
+            y: vec![],
             steps,
             phi: 1.0,
             min_scale: 0.0,
             fixed: HashMap::new(),
             grid_cache: RefCell::new(HashMap::new()),
             grid_bytes: Cell::new(0),
+            off_grid: RefCell::new(HashMap::new()),
+            off_grid_bytes: Cell::new(0),
         };
         let mut kinds = vec![Kind::Constant];
         kinds.extend(
@@ -133,10 +150,19 @@ impl<'a> Design<'a> {
                 .filter(|s| s.available(inp))
                 .map(Kind::Shape),
         );
-        for k in kinds {
-            let raw = d.raw(&Term::of(k));
-            let w = d.whiten_raw(&raw);
-            d.fixed.insert(key(k), w);
+        // The residual and every fixed column whitened together.
+        let raws: Vec<Raw> = kinds.iter().map(|k| d.raw(&Term::of(*k))).collect();
+        let mut all: Vec<&[f64]> = vec![&d.r];
+        for raw in &raws {
+            all.extend(raw.cols.iter().map(Vec::as_slice));
+            all.extend(raw.offset.as_deref());
+        }
+        let mut w = d.wh.whiten_many(&all).into_iter();
+        d.y = w.next().unwrap_or_default();
+        for (k, raw) in kinds.iter().zip(&raws) {
+            let cols = w.by_ref().take(raw.cols.len()).collect();
+            let offset = raw.offset.as_ref().and_then(|_| w.next());
+            d.fixed.insert(key(*k), (cols, offset));
         }
         d
     }
@@ -207,37 +233,93 @@ impl<'a> Design<'a> {
     }
 
     fn whiten_raw(&self, raw: &Raw) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
-        (
-            raw.cols.iter().map(|c| self.wh.whiten(c)).collect(),
-            raw.offset.as_ref().map(|o| self.wh.whiten(o)),
-        )
+        let mut all: Vec<&[f64]> = raw.cols.iter().map(Vec::as_slice).collect();
+        all.extend(raw.offset.as_deref());
+        let mut w = self.wh.whiten_many(&all);
+        let offset = raw.offset.as_ref().and_then(|_| w.pop());
+        (w, offset)
     }
 
-    /// A term's whitened columns and fixed part.
+    /// A term's whitened columns and fixed part: held, kept from an
+    /// earlier call, or computed and kept.
     fn whitened(&self, t: &Term) -> WRef<'_> {
         if let Some(w) = self.fixed.get(&key(t.kind)) {
             return WRef::Held(w);
         }
-        WRef::Owned(self.whiten_raw(&self.raw(t)))
+        let k = (key(t.kind), t.x.to_bits());
+        if let Some(w) = self.grid_cache.borrow().get(&k) {
+            return WRef::Shared(w.clone());
+        }
+        if let Some(w) = self.off_grid.borrow().get(&k) {
+            return WRef::Shared(w.clone());
+        }
+        let w = Rc::new(self.whiten_raw(&self.raw(t)));
+        let bytes = bytes_of(&w);
+        if self.off_grid_bytes.get() + bytes > OFF_GRID_CACHE_BYTES {
+            self.off_grid.borrow_mut().clear();
+            self.off_grid_bytes.set(0);
+        }
+        self.off_grid_bytes.set(self.off_grid_bytes.get() + bytes);
+        self.off_grid.borrow_mut().insert(k, w.clone());
+        WRef::Shared(w)
     }
 
-    /// [`Self::whitened`] at a point of the term's grid: kept for the
-    /// next search while memory allows.
+    /// [`Self::whitened`] at a point of the term's grid: on the first, the
+    /// whole grid is whitened at once and kept while memory allows.
     fn whitened_on_grid(&self, t: &Term) -> WRef<'_> {
         let k = (key(t.kind), t.x.to_bits());
         if let Some(w) = self.grid_cache.borrow().get(&k) {
             return WRef::Shared(w.clone());
         }
-        let w = self.whiten_raw(&self.raw(t));
-        let bytes =
-            8 * (w.0.iter().map(Vec::len).sum::<usize>() + w.1.as_ref().map_or(0, Vec::len));
+        self.fill_grid(t.kind);
+        if let Some(w) = self.grid_cache.borrow().get(&k) {
+            return WRef::Shared(w.clone());
+        }
+        self.whitened(t)
+    }
+
+    /// Whitens the grid points of `kind` not yet kept, all together, and
+    /// keeps them if they fit in [`GRID_CACHE_BYTES`].
+    fn fill_grid(&self, kind: Kind) {
+        let (grid, _) = self.grid(&Term::of(kind));
+        let missing: Vec<Term> = grid
+            .iter()
+            .map(|&x| Term { kind, x })
+            .filter(|t| {
+                !self
+                    .grid_cache
+                    .borrow()
+                    .contains_key(&(key(kind), t.x.to_bits()))
+            })
+            .collect();
+        let Some(first) = missing.first() else {
+            return;
+        };
+        let r0 = self.raw(first);
+        let per = 8
+            * (r0.cols.iter().map(Vec::len).sum::<usize>()
+                + r0.offset.as_ref().map_or(0, Vec::len));
+        let bytes = per * missing.len();
         if self.grid_bytes.get() + bytes > GRID_CACHE_BYTES {
-            return WRef::Owned(w);
+            return;
+        }
+        // A few points at a time: their raw columns are transient.
+        for chunk in missing.chunks(WHITEN_TERMS) {
+            let raws: Vec<Raw> = chunk.iter().map(|t| self.raw(t)).collect();
+            let mut all: Vec<&[f64]> = vec![];
+            for raw in &raws {
+                all.extend(raw.cols.iter().map(Vec::as_slice));
+                all.extend(raw.offset.as_deref());
+            }
+            let mut w = self.wh.whiten_many(&all).into_iter();
+            let mut cache = self.grid_cache.borrow_mut();
+            for (t, raw) in chunk.iter().zip(&raws) {
+                let cols = w.by_ref().take(raw.cols.len()).collect();
+                let offset = raw.offset.as_ref().and_then(|_| w.next());
+                cache.insert((key(kind), t.x.to_bits()), Rc::new((cols, offset)));
+            }
         }
         self.grid_bytes.set(self.grid_bytes.get() + bytes);
-        let w = Rc::new(w);
-        self.grid_cache.borrow_mut().insert(k, w.clone());
-        WRef::Shared(w)
     }
 
     /// The fixed part of the searches of `terms[j]`'s parameter.
@@ -272,25 +354,34 @@ impl<'a> Design<'a> {
     /// The whitened columns of `terms` and the whitened residual less
     /// their fixed parts.
     pub fn whitened_problem(&self, terms: &[Term]) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let (ws, y) = self.whitened_terms(terms);
+        let cols = ws.iter().flat_map(|w| w.get().0.iter().cloned()).collect();
+        (cols, y)
+    }
+
+    /// The whitened columns of `terms` (held, not copied) and the whitened
+    /// residual less their fixed parts.
+    fn whitened_terms(&self, terms: &[Term]) -> (Vec<WRef<'_>>, Vec<f64>) {
         let mut y = self.y.clone();
-        let mut cols: Vec<Vec<f64>> = vec![];
-        for t in terms {
-            let w = self.whitened(t);
-            let (c, o) = w.get();
-            if let Some(o) = o {
+        let ws: Vec<WRef> = terms.iter().map(|t| self.whitened(t)).collect();
+        for w in &ws {
+            if let Some(o) = &w.get().1 {
                 for (a, b) in y.iter_mut().zip(o) {
                     *a -= b;
                 }
             }
-            cols.extend(c.iter().cloned());
         }
-        (cols, y)
+        (ws, y)
     }
 
     /// Joint least-squares fit of `terms` on the whitened problem; None
     /// when their columns are degenerate.
     pub fn fit(&self, terms: &[Term]) -> Option<Fit> {
-        let (cols, y) = self.whitened_problem(terms);
+        let (ws, y) = self.whitened_terms(terms);
+        let cols: Vec<&[f64]> = ws
+            .iter()
+            .flat_map(|w| w.get().0.iter().map(Vec::as_slice))
+            .collect();
         let coef = if cols.is_empty() {
             vec![]
         } else {
@@ -298,11 +389,11 @@ impl<'a> Design<'a> {
         };
         let mut resid = y;
         for (c, b) in cols.iter().zip(&coef) {
-            for (r, v) in resid.iter_mut().zip(c) {
+            for (r, v) in resid.iter_mut().zip(c.iter()) {
                 *r -= b * v;
             }
         }
-        let sse = resid.iter().map(|v| v * v).sum();
+        let sse = sum_sq(&resid);
         Some(Fit { coef, resid, sse })
     }
 

@@ -158,8 +158,10 @@ fn reml(m: &NoiseModel, p: &Problem) -> f64 {
 /// no Gram determinant: the one that compares fits of different columns).
 pub fn loglik(m: &NoiseModel, p: &Problem, restricted: bool) -> f64 {
     let w = p.whitener(m);
-    let yw = w.whiten(&p.y);
-    let cw: Vec<Vec<f64>> = p.cols.iter().map(|c| w.whiten(c)).collect();
+    let mut all: Vec<&[f64]> = vec![&p.y];
+    all.extend(p.cols.iter().map(Vec::as_slice));
+    let mut cw = w.whiten_many(&all);
+    let yw = cw.remove(0);
     let sse = match super::normal::normal_solve(&cw, &yw) {
         Some(b) if !cw.is_empty() => {
             let mut r = yw.clone();

@@ -323,6 +323,9 @@ pub fn markov_mean_var(x: f64) -> f64 {
     }
 }
 
+/// Columns [`Whitener::whiten_many`] filters side by side.
+const WHITEN_GROUP: usize = 8;
+
 /// A correlated process faster than this many of its correlation times
 /// per observation is white there.
 const WHITE_BEYOND: f64 = 3.0;
@@ -364,8 +367,12 @@ impl Whitener {
         let white = noise.white + white_extra;
         let s = 1 + taus.len();
         let mut counts: Vec<f64> = win.count.clone();
-        counts.sort_by(f64::total_cmp);
-        let nominal = counts.get(counts.len() / 2).copied().unwrap_or(1.0);
+        let mid = counts.len() / 2;
+        let nominal = if counts.is_empty() {
+            1.0
+        } else {
+            *counts.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
         // P: covariance of the state prediction (s x s, row-major).
         let mut p = vec![0.0; s * s];
         for i in 1..s {
@@ -377,6 +384,7 @@ impl Whitener {
         let mut log_det = 0.0;
         let mut ph = vec![1.0; s];
         let mut last_dt = f64::NAN;
+        let mut ph1 = vec![0.0; s];
         for k in 0..n {
             if k > 0 {
                 let dt = (win.t[k] - win.t[k - 1]).max(0.0);
@@ -398,9 +406,12 @@ impl Whitener {
                         };
                     }
                 }
+                // P stays symmetric (each pair's update is the same
+                // product): the upper triangle, mirrored.
                 for i in 0..s {
-                    for j in 0..s {
+                    for j in i..s {
                         p[i * s + j] *= ph[i] * ph[j];
+                        p[j * s + i] = p[i * s + j];
                     }
                 }
                 p[0] += noise.random_walk * dt;
@@ -413,7 +424,9 @@ impl Whitener {
                 continue;
             }
             // Observation: the sum of the states plus white noise.
-            let ph1: Vec<f64> = (0..s).map(|i| (0..s).map(|j| p[i * s + j]).sum()).collect();
+            for (i, v) in ph1.iter_mut().enumerate() {
+                *v = p[i * s..(i + 1) * s].iter().sum();
+            }
             let f = ph1.iter().sum::<f64>() + white * nominal / win.count[k].max(1e-9);
             if f <= 0.0 || !f.is_finite() {
                 continue;
@@ -422,8 +435,9 @@ impl Whitener {
                 gain[k * s + i] = ph1[i] / f;
             }
             for i in 0..s {
-                for j in 0..s {
+                for j in i..s {
                     p[i * s + j] -= ph1[i] * ph1[j] / f;
+                    p[j * s + i] = p[i * s + j];
                 }
             }
             inv_sd[k] = 1.0 / f.sqrt();
@@ -458,6 +472,68 @@ impl Whitener {
             out[k] = v * self.inv_sd[k];
             for (ai, g) in a.iter_mut().zip(&self.gain[k * s..(k + 1) * s]) {
                 *ai += g * v;
+            }
+        }
+        out
+    }
+
+    /// [`Self::whiten`] of each of `xs` (bit for bit the same), taken
+    /// [`WHITEN_GROUP`] at a time: the filter's factors and gains (the
+    /// states times the windows, megabytes on a day-long record) are read
+    /// once per group, and the columns' recursions, each a chain of
+    /// dependent additions, run side by side.
+    pub fn whiten_many(&self, xs: &[&[f64]]) -> Vec<Vec<f64>> {
+        let mut out = Vec::with_capacity(xs.len());
+        for group in xs.chunks(WHITEN_GROUP) {
+            out.extend(match group.len() {
+                1 => self.whiten_group::<1>(group),
+                2 => self.whiten_group::<2>(group),
+                3 | 4 => self.whiten_group::<4>(group),
+                _ => self.whiten_group::<WHITEN_GROUP>(group),
+            });
+        }
+        out
+    }
+
+    /// [`Self::whiten`] of up to `G` columns, the states
+    /// held state by state across the columns (the same operations on
+    /// each column, in the same order, as [`Self::whiten`]'s).
+    fn whiten_group<const G: usize>(&self, xs: &[&[f64]]) -> Vec<Vec<f64>> {
+        let s = self.states;
+        let n = xs.iter().map(|x| x.len()).max().unwrap_or(0);
+        let mut a = vec![[0.0f64; G]; s];
+        let mut out: Vec<Vec<f64>> = xs.iter().map(|x| vec![0.0; x.len()]).collect();
+        for k in 0..n {
+            if k > 0 {
+                let f = &self.phi[k * s..(k + 1) * s];
+                for (ai, fi) in a.iter_mut().zip(f) {
+                    for v in ai.iter_mut() {
+                        *v *= fi;
+                    }
+                }
+            }
+            if !self.keep[k] || self.inv_sd[k] == 0.0 {
+                continue;
+            }
+            // The prediction, summed state by state as `Iterator::sum`
+            // does (from -0.0).
+            let mut v = [-0.0f64; G];
+            for ai in &a {
+                for j in 0..G {
+                    v[j] += ai[j];
+                }
+            }
+            for (j, x) in xs.iter().enumerate() {
+                v[j] = x.get(k).copied().unwrap_or(0.0) - v[j];
+                if let Some(o) = out[j].get_mut(k) {
+                    *o = v[j] * self.inv_sd[k];
+                }
+            }
+            let g = &self.gain[k * s..(k + 1) * s];
+            for (ai, gi) in a.iter_mut().zip(g) {
+                for j in 0..G {
+                    ai[j] += gi * v[j];
+                }
             }
         }
         out
@@ -530,6 +606,35 @@ mod tests {
         assert!((var - 1.0).abs() < 0.2, "{var}");
         for k in 2..400 {
             assert!(((walk[k] - walk[k - 1]) / 0.5 - y[k]).abs() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn columns_whitened_together_are_whitened_alone() {
+        let n = 3000;
+        let win = windows(n);
+        let keep: Vec<bool> = (0..n).map(|k| k % 97 != 5).collect();
+        let m = NoiseModel {
+            white: 2.0,
+            flicker: 0.3,
+            random_walk: 1e-3,
+            markov: 0.5,
+            markov_s: 40.0,
+        };
+        let w = Whitener::new(&m, &win, &keep);
+        let cols: Vec<Vec<f64>> = (0..11)
+            .map(|j| {
+                (0..n - j)
+                    .map(|k| ((k * (j + 3)) as f64 * 0.01).sin() + j as f64)
+                    .collect()
+            })
+            .collect();
+        let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        let many = w.whiten_many(&refs);
+        for (c, got) in cols.iter().zip(&many) {
+            let one = w.whiten(c);
+            assert_eq!(one.len(), got.len());
+            assert!(one.iter().zip(got).all(|(a, b)| a.to_bits() == b.to_bits()));
         }
     }
 

@@ -3,27 +3,29 @@
 //! candidate, and exact enough with the columns scaled to unit norm; the
 //! final estimates and their covariance use the QR of numerics/lsq.rs.
 
+use crate::numerics::dot::{dots, sum_sq};
+
 /// Least squares by the normal equations of the columns scaled to unit
 /// norm (Cholesky); None when a pivot falls below 1e-10 of the diagonal
 /// (collinear columns, or a column of zeros).
-pub fn normal_solve(cols: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
+pub fn normal_solve<C: AsRef<[f64]>>(cols: &[C], y: &[f64]) -> Option<Vec<f64>> {
     let m = cols.len();
-    let norms: Vec<f64> = cols
-        .iter()
-        .map(|c| c.iter().map(|v| v * v).sum::<f64>().sqrt())
-        .collect();
+    let norms: Vec<f64> = cols.iter().map(|c| sum_sq(c.as_ref()).sqrt()).collect();
     if norms.iter().any(|n| !(n.is_finite() && *n > 0.0)) {
         return None;
     }
     let mut a = vec![0.0; m * m];
     let mut b = vec![0.0; m];
     for i in 0..m {
+        // Column i against the columns before it and y, in one pass.
+        let mut others: Vec<&[f64]> = cols[..=i].iter().map(|c| c.as_ref()).collect();
+        others.push(y);
+        let p = dots(cols[i].as_ref(), &others);
         for j in 0..=i {
-            let s: f64 = cols[i].iter().zip(&cols[j]).map(|(p, q)| p * q).sum();
-            a[i * m + j] = s / (norms[i] * norms[j]);
+            a[i * m + j] = p[j] / (norms[i] * norms[j]);
             a[j * m + i] = a[i * m + j];
         }
-        b[i] = cols[i].iter().zip(y).map(|(p, q)| p * q).sum::<f64>() / norms[i];
+        b[i] = p[i + 1] / norms[i];
     }
     let z = cholesky_solve(a, &b, m)?;
     Some(z.iter().zip(&norms).map(|(v, n)| v / n).collect())

@@ -20,10 +20,7 @@ pub struct Projection {
 }
 
 use super::normal::cholesky_solve;
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| p * q).sum()
-}
+use crate::numerics::dot::{dot, dots};
 
 impl Projection {
     /// The fixed set: whitened columns `cols` and whitened residual `y`
@@ -35,14 +32,19 @@ impl Projection {
         }
         let p = cols.len();
         let mut gram = vec![0.0; p * p];
+        let mut xy = vec![0.0; p];
         for i in 0..p {
+            // Column i against those before it and y, in one pass.
+            let mut others: Vec<&[f64]> = cols[..=i].iter().map(Vec::as_slice).collect();
+            others.push(&y);
+            let d = dots(&cols[i], &others);
             for j in 0..=i {
-                let v = dot(&cols[i], &cols[j]) / (norms[i] * norms[j]);
+                let v = d[j] / (norms[i] * norms[j]);
                 gram[i * p + j] = v;
                 gram[j * p + i] = v;
             }
+            xy[i] = d[i + 1] / norms[i];
         }
-        let xy = (0..p).map(|i| dot(&cols[i], &y) / norms[i]).collect();
         let yy = dot(&y, &y);
         Some(Self {
             cols,
@@ -60,18 +62,16 @@ impl Projection {
         let p = self.cols.len();
         let k = extra.len();
         let m = p + k;
-        let en: Vec<f64> = extra.iter().map(|c| dot(c, c).sqrt()).collect();
-        if en.iter().any(|n| !(n.is_finite() && *n > 0.0)) {
-            return f64::INFINITY;
-        }
+        let fixed: Vec<&[f64]> = self.cols.iter().map(Vec::as_slice).collect();
         // y' = y - o: its products with the fixed columns and itself.
         let (mut xy, yy) = match offset {
             Some(o) => {
-                let xo: Vec<f64> = (0..p)
-                    .map(|i| dot(&self.cols[i], o) / self.norms[i])
-                    .collect();
-                let xy: Vec<f64> = self.xy.iter().zip(&xo).map(|(a, b)| a - b).collect();
-                (xy, self.yy - 2.0 * dot(&self.y, o) + dot(o, o))
+                let mut with = fixed.clone();
+                with.push(&self.y);
+                with.push(o);
+                let d = dots(o, &with);
+                let xy: Vec<f64> = (0..p).map(|i| self.xy[i] - d[i] / self.norms[i]).collect();
+                (xy, self.yy - 2.0 * d[p] + d[p + 1])
             }
             None => (self.xy.clone(), self.yy),
         };
@@ -79,21 +79,35 @@ impl Projection {
         for i in 0..p {
             a[i * m..i * m + p].copy_from_slice(&self.gram[i * p..(i + 1) * p]);
         }
+        let mut en = vec![0.0; k];
         for (q, c) in extra.iter().enumerate() {
+            // Its products with the fixed columns, y, the offset and the
+            // extra columns up to itself, in one pass over the rows.
+            let mut with = fixed.clone();
+            with.push(&self.y);
+            with.extend(offset);
+            with.extend(extra[..=q].iter().map(Vec::as_slice));
+            let d = dots(c, &with);
+            let e0 = p + 1 + usize::from(offset.is_some());
+            let cc = d[e0 + q];
+            en[q] = cc.sqrt();
+            if !(en[q].is_finite() && en[q] > 0.0) {
+                return f64::INFINITY;
+            }
             let r = p + q;
             for i in 0..p {
-                let v = dot(c, &self.cols[i]) / (en[q] * self.norms[i]);
+                let v = d[i] / (en[q] * self.norms[i]);
                 a[r * m + i] = v;
                 a[i * m + r] = v;
             }
-            for (q2, c2) in extra.iter().enumerate().take(q + 1) {
-                let v = dot(c, c2) / (en[q] * en[q2]);
+            for q2 in 0..=q {
+                let v = d[e0 + q2] / (en[q] * en[q2]);
                 a[r * m + p + q2] = v;
                 a[(p + q2) * m + r] = v;
             }
             let cy = match offset {
-                Some(o) => dot(c, &self.y) - dot(c, o),
-                None => dot(c, &self.y),
+                Some(_) => d[p] - d[p + 1],
+                None => d[p],
             };
             xy.push(cy / en[q]);
         }
