@@ -55,19 +55,35 @@ pub const THERMAL: [Effect; 5] = [
     Effect::WarmUp,
 ];
 
-/// A disturbance outside the library, drawn, with its profile.
-fn outside(o: Outside, i: u64, rng: &mut Xoshiro256PlusPlus) -> (TestProfile, Extra) {
+/// A disturbance outside the library, drawn, with its profile, at 4 to 9
+/// times the 1 s noise floor (its 1 s means' RMS, their mean removed,
+/// over the white noise's of a 1 s mean).
+fn outside(o: Outside, i: u64, seed: u64, rng: &mut Xoshiro256PlusPlus) -> (TestProfile, Extra) {
     let at_rest = [TestProfile::Chamber, TestProfile::FogChamber][(i % 2) as usize];
-    match o {
-        // 0.5 .. 2 deg/h at 200 deg/s.
-        Outside::RateSquared => (
-            TestProfile::Table,
-            Extra::RateSquared(signed(rng, 0.5, 2.0) / 4e4),
+    let one = |rng: &mut Xoshiro256PlusPlus| signed(rng, 1.0, 1.0);
+    let (p, x) = match o {
+        Outside::RateSquared => (TestProfile::Table, Extra::RateSquared(one(rng))),
+        Outside::RateCubed => (TestProfile::Table, Extra::RateCubed(one(rng))),
+        Outside::RateAbsRate => (TestProfile::Table, Extra::RateAbsRate(one(rng))),
+        Outside::BiasTempSquared => (
+            TestProfile::FogChamber,
+            Extra::BiasTempSquared {
+                c: one(rng),
+                t0_c: uni(rng, 10.0, 40.0),
+            },
         ),
-        Outside::RateCubed => (
+        Outside::ScaleFactorTempSquared => (
             TestProfile::Table,
-            Extra::RateCubed(signed(rng, 0.5, 2.0) / 8e6),
+            Extra::ScaleFactorTempSquared {
+                c: one(rng),
+                t0_c: uni(rng, 10.0, 40.0),
+            },
         ),
+        Outside::TempCurvature => (TestProfile::FogChamber, Extra::TempCurvature(one(rng))),
+        Outside::ScaleFactorTempRate => (TestProfile::Table, Extra::ScaleFactorTempRate(one(rng))),
+        Outside::CaseMinusMono => (TestProfile::Chamber, Extra::CaseMinusMono(one(rng))),
+        Outside::CaseRate => (TestProfile::Chamber, Extra::CaseRate(one(rng))),
+        Outside::AbsAcceleration => (TestProfile::Vibration, Extra::AbsAcceleration(one(rng))),
         Outside::BiasStep => {
             let p = [
                 TestProfile::Table,
@@ -79,18 +95,28 @@ fn outside(o: Outside, i: u64, rng: &mut Xoshiro256PlusPlus) -> (TestProfile, Ex
                 p,
                 Extra::BiasStep {
                     at_s: uni(rng, 0.3, 0.7) * dur,
-                    dph: signed(rng, 0.1, 0.5),
+                    dph: one(rng),
                 },
             )
         }
-        Outside::RateRamp => (at_rest, Extra::RateRamp(signed(rng, 0.03, 0.1))),
-        // The coil's curvature peaks near 3e-5 degC/s^2 at the ramps' ends:
-        // 0.15 .. 0.9 deg/h.
-        Outside::TempCurvature => (
-            TestProfile::FogChamber,
-            Extra::TempCurvature(signed(rng, 5e3, 3e4)),
+        Outside::Periodic => (
+            at_rest,
+            Extra::Periodic {
+                dph: one(rng),
+                period_s: uni(rng, 1200.0, 3600.0),
+                phase: uni(rng, 0.0, std::f64::consts::TAU),
+            },
         ),
-    }
+        Outside::RateRamp => (at_rest, Extra::RateRamp(one(rng))),
+    };
+    let floor = TrialNoise::nominal(p.gyro()).arw_dpsh * 60.0;
+    let target = uni(rng, 4.0, 9.0) * floor;
+    let inp = inputs_of(p, seed, None);
+    let m = Windows::new(&inp.t, 1.0).mean(&x.contribution(&inp));
+    let mean = m.iter().sum::<f64>() / m.len().max(1) as f64;
+    let rms =
+        (m.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / m.len().max(1) as f64).sqrt() * 3600.0;
+    (p, x.scaled(if rms > 0.0 { target / rms } else { 1.0 }))
 }
 
 /// `h` scaled so that its contribution's 1 s means have an RMS of `target`
@@ -236,8 +262,9 @@ pub fn trials(a: &TrialCounts) -> Vec<Trial> {
     }
     for o in Outside::ALL {
         for i in 0..a.outside {
-            let (p, x) = outside(o, i, &mut rng);
-            let mut t = Trial::hiding(TrialKind::Outside(o), p, vec![], vec![], next());
+            let s = next();
+            let (p, x) = outside(o, i, s, &mut rng);
+            let mut t = Trial::hiding(TrialKind::Outside(o), p, vec![], vec![], s);
             t.extras = vec![x];
             out.push(t);
         }

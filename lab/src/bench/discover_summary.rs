@@ -49,7 +49,61 @@ impl Tally {
     }
 }
 
+/// Issue 32's figures: terms outside the library proposed where they are
+/// missing, and nowhere else.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Beyond {
+    pub physical: usize,
+    pub physical_explained: usize,
+    pub events: usize,
+    pub events_explained: usize,
+    /// Outside trials explained with library effects named beside (or
+    /// instead of) a term: the hidden shape spans them.
+    pub explained_with_library_names: usize,
+    /// Outside trials whose model written predicts a second run.
+    pub second_runs: usize,
+    pub second_runs_predicted: usize,
+    /// Nulls (nothing missing, coloured noise) with any term named.
+    pub nulls: usize,
+    pub nulls_with_term: usize,
+    /// Trials hiding library effects with any term named.
+    pub library: usize,
+    pub library_with_term: usize,
+}
+
+fn beyond(outcomes: &[Outcome]) -> Beyond {
+    let mut b = Beyond::default();
+    for o in outcomes {
+        match o.kind {
+            TrialKind::Outside(x) => {
+                if x.is_event() {
+                    b.events += 1;
+                    b.events_explained += usize::from(o.right);
+                } else {
+                    b.physical += 1;
+                    b.physical_explained += usize::from(o.right);
+                }
+                b.explained_with_library_names += usize::from(o.right && !o.named.is_empty());
+                if let Some(p) = o.predicts_b {
+                    b.second_runs += 1;
+                    b.second_runs_predicted += usize::from(p);
+                }
+            }
+            TrialKind::NothingMissing | TrialKind::ColouredNull => {
+                b.nulls += 1;
+                b.nulls_with_term += usize::from(o.terms > 0);
+            }
+            _ => {
+                b.library += 1;
+                b.library_with_term += usize::from(o.terms > 0);
+            }
+        }
+    }
+    b
+}
+
 pub struct Summary {
+    pub beyond: Beyond,
     pub total: Tally,
     /// Per category (the trial kinds, single effects together).
     pub categories: BTreeMap<String, Tally>,
@@ -93,6 +147,9 @@ fn confusion(outcomes: &[Outcome]) -> Confusion {
         if o.unexplained {
             *r.entry("unexplained".into()).or_default() += 1;
         }
+        if o.terms > 0 {
+            *r.entry("term".into()).or_default() += 1;
+        }
         if o.gap_grew {
             *r.entry("gap grew".into()).or_default() += 1;
         }
@@ -108,6 +165,7 @@ pub fn summarize(outcomes: &[Outcome]) -> Summary {
         categories.entry(category(o.kind)).or_default().add(o);
     }
     Summary {
+        beyond: beyond(outcomes),
         total,
         categories,
         confusion: confusion(outcomes),

@@ -93,9 +93,57 @@ pub enum Extra {
     /// k d2T/dt2 of the main (FOG) or case (RLG) temperature, deg/h per
     /// degC/s^2.
     TempCurvature(f64),
+    /// c w|w|, deg/h per (deg/s)^2.
+    RateAbsRate(f64),
+    /// c (T - t0)^2 of the coil, deg/h per degC^2.
+    BiasTempSquared { c: f64, t0_c: f64 },
+    /// c w (T - t0)^2, deg/h per deg/s per degC^2.
+    ScaleFactorTempSquared { c: f64, t0_c: f64 },
+    /// c w dT/dt, deg/h per deg/s per degC/s.
+    ScaleFactorTempRate(f64),
+    /// c (T_case - (T_mono_a + T_mono_b)/2), deg/h per degC.
+    CaseMinusMono(f64),
+    /// c dT_case/dt, deg/h per degC/s.
+    CaseRate(f64),
+    /// c |angular acceleration|, deg/h per deg/s^2.
+    AbsAcceleration(f64),
+    /// amp sin(2 pi t / period + phase), deg/h.
+    Periodic { dph: f64, period_s: f64, phase: f64 },
 }
 
+/// Half width of each of the two slopes the generator's d2T/dt2 takes, s.
+const CURVATURE_HALF_WIDTH_S: f64 = 120.0;
+
 impl Extra {
+    /// The disturbance with its size multiplied by `f`.
+    pub fn scaled(self, f: f64) -> Self {
+        match self {
+            Extra::RateSquared(c) => Extra::RateSquared(c * f),
+            Extra::RateCubed(c) => Extra::RateCubed(c * f),
+            Extra::BiasStep { at_s, dph } => Extra::BiasStep { at_s, dph: dph * f },
+            Extra::RateRamp(c) => Extra::RateRamp(c * f),
+            Extra::TempCurvature(c) => Extra::TempCurvature(c * f),
+            Extra::RateAbsRate(c) => Extra::RateAbsRate(c * f),
+            Extra::BiasTempSquared { c, t0_c } => Extra::BiasTempSquared { c: c * f, t0_c },
+            Extra::ScaleFactorTempSquared { c, t0_c } => {
+                Extra::ScaleFactorTempSquared { c: c * f, t0_c }
+            }
+            Extra::ScaleFactorTempRate(c) => Extra::ScaleFactorTempRate(c * f),
+            Extra::CaseMinusMono(c) => Extra::CaseMinusMono(c * f),
+            Extra::CaseRate(c) => Extra::CaseRate(c * f),
+            Extra::AbsAcceleration(c) => Extra::AbsAcceleration(c * f),
+            Extra::Periodic {
+                dph,
+                period_s,
+                phase,
+            } => Extra::Periodic {
+                dph: dph * f,
+                period_s,
+                phase,
+            },
+        }
+    }
+
     /// Its contribution, deg/s, on `inp`.
     pub fn contribution(&self, inp: &Inputs) -> Vec<f64> {
         use crate::model::inputs::{centered_slope, RATE_HALF_WIDTH_S};
@@ -109,12 +157,60 @@ impl Extra {
                 .map(|&t| if t >= at_s { dph * d } else { 0.0 })
                 .collect(),
             Extra::RateRamp(r) => inp.t.iter().map(|t| r * d * t / 3600.0).collect(),
+            Extra::RateAbsRate(c) => inp.w.iter().map(|w| c * d * w * w.abs()).collect(),
+            Extra::BiasTempSquared { c, t0_c } => match &inp.temp {
+                Some(x) => x.iter().map(|v| c * d * (v - t0_c).powi(2)).collect(),
+                None => vec![0.0; inp.len()],
+            },
+            Extra::ScaleFactorTempSquared { c, t0_c } => match &inp.temp {
+                Some(x) => x
+                    .iter()
+                    .zip(&inp.w)
+                    .map(|(v, w)| c * d * w * (v - t0_c).powi(2))
+                    .collect(),
+                None => vec![0.0; inp.len()],
+            },
+            Extra::ScaleFactorTempRate(c) => match &inp.temp {
+                Some(x) => centered_slope(&inp.t, x, RATE_HALF_WIDTH_S)
+                    .iter()
+                    .zip(&inp.w)
+                    .map(|(r, w)| c * d * w * r)
+                    .collect(),
+                None => vec![0.0; inp.len()],
+            },
+            Extra::CaseMinusMono(c) => match (&inp.case, &inp.mono) {
+                (Some(k), Some((a, b))) => k
+                    .iter()
+                    .zip(a.iter().zip(b))
+                    .map(|(k, (a, b))| c * d * (k - 0.5 * (a + b)))
+                    .collect(),
+                _ => vec![0.0; inp.len()],
+            },
+            Extra::CaseRate(c) => match &inp.case {
+                Some(k) => centered_slope(&inp.t, k, RATE_HALF_WIDTH_S)
+                    .iter()
+                    .map(|r| c * d * r)
+                    .collect(),
+                None => vec![0.0; inp.len()],
+            },
+            Extra::AbsAcceleration(c) => inp.acc.iter().map(|a| c * d * a.abs()).collect(),
+            Extra::Periodic {
+                dph,
+                period_s,
+                phase,
+            } => inp
+                .t
+                .iter()
+                .map(|t| dph * d * (std::f64::consts::TAU * t / period_s + phase).sin())
+                .collect(),
             Extra::TempCurvature(k) => {
                 let temp = inp.temp.as_ref().or(inp.case.as_ref());
                 match temp {
+                    // The curvature of the temperature itself, smooth over
+                    // minutes (the sensor's quantization is not the gyro's).
                     Some(x) => {
-                        let r = centered_slope(&inp.t, x, RATE_HALF_WIDTH_S);
-                        centered_slope(&inp.t, &r, RATE_HALF_WIDTH_S)
+                        let r = centered_slope(&inp.t, x, CURVATURE_HALF_WIDTH_S);
+                        centered_slope(&inp.t, &r, CURVATURE_HALF_WIDTH_S)
                             .iter()
                             .map(|c| k * d * c)
                             .collect()

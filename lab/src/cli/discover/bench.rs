@@ -37,7 +37,7 @@ pub struct DiscoverBenchArgs {
     /// Trials per thermal term with a bias (5 terms).
     #[arg(long, default_value_t = 3)]
     pub bias_thermal: u64,
-    /// Trials per disturbance outside the library (5 kinds).
+    /// Trials per disturbance outside the library (13 kinds).
     #[arg(long, default_value_t = 3)]
     pub outside: u64,
     #[command(flatten)]
@@ -85,6 +85,22 @@ fn print_discover(s: &Summary, n: usize) {
             t.coverage_pct()
         );
     }
+    let b = &s.beyond;
+    println!(
+        "outside the library: physical terms explained {}/{} (what the model added correlating >= 0.95 with the hidden term, the gap after <= 1.25 x the floor), events {}/{} ({} of those explained with library effects named beside or instead of a term); \
+         the model written predicted a second run (gap, bias removed, <= 1.5 x the floor) in {}/{}; a term named on {}/{} nulls and {}/{} runs hiding library effects",
+        b.physical_explained,
+        b.physical,
+        b.events_explained,
+        b.events,
+        b.explained_with_library_names,
+        b.second_runs_predicted,
+        b.second_runs,
+        b.nulls_with_term,
+        b.nulls,
+        b.library_with_term,
+        b.library
+    );
     let t = &s.total;
     println!(
         "right {}/{} ({:.1} %); false names {}; the gap grew in {}; 95 % intervals hold the truth for {}/{} parameters ({:.1} %) of the named hidden effects; \
@@ -141,6 +157,7 @@ pub fn discover(a: &DiscoverBenchArgs) -> Result<(), LabError> {
             "covered": s.total.covered,
             "coverage_pct": s.total.coverage_pct(),
             "categories": s.categories,
+            "beyond_library": s.beyond,
             "confusion": s.confusion,
             "outcomes": outcomes,
         })

@@ -171,12 +171,26 @@ fn term_json(t: &TermFound) -> serde_json::Value {
 /// The JSON of a discovery (docs/interfaces.md keys and more).
 pub fn json(d: &Discovery) -> serde_json::Value {
     let mut found: Vec<serde_json::Value> = d.found.iter().map(estimate_json).collect();
+    // Added: the terms proposed and named. A user's terms were not added
+    // (they were in the model given): they are under `model_terms`, with
+    // their parameters as fitted here.
     found.extend(
         d.terms
             .iter()
-            .filter(|t| t.carried.is_none())
+            .filter(|t| t.proposed && t.carried.is_none())
             .map(term_json),
     );
+    let model_terms: Vec<serde_json::Value> = d
+        .terms
+        .iter()
+        .filter(|t| !t.proposed)
+        .map(|t| {
+            let mut j = term_json(t);
+            j["named"] = t.carried.is_none().into();
+            j["why"] = t.carried.clone().into();
+            j
+        })
+        .collect();
     let mut carried: Vec<serde_json::Value> = d
         .carried
         .iter()
@@ -186,7 +200,7 @@ pub fn json(d: &Discovery) -> serde_json::Value {
             j
         })
         .collect();
-    carried.extend(d.terms.iter().filter_map(|t| {
+    carried.extend(d.terms.iter().filter(|t| t.proposed).filter_map(|t| {
         t.carried.as_ref().map(|why| {
             let mut j = term_json(t);
             j["why"] = why.clone().into();
@@ -225,6 +239,7 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "ambiguous": d.ambiguous,
         "unexplained": d.unexplained,
         "carried": carried,
+        "model_terms": model_terms,
         "implausible": implausible,
         "dropped": d.dropped,
         "not_confirmed": d
@@ -344,7 +359,12 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     print_text(a, &d);
     if let Some((p, v, terms)) = &validation {
         print_validation(p, v);
-        for (t, s) in d.terms.iter().filter(|t| t.carried.is_none()).zip(terms) {
+        for (t, s) in d
+            .terms
+            .iter()
+            .filter(|t| t.proposed && t.carried.is_none())
+            .zip(terms)
+        {
             println!(
                 "  the term {} on {}: the gap (bias removed) {:.4} deg/h with it, {:.4} without: {}",
                 t.term.formula,
@@ -392,7 +412,7 @@ fn second_run_terms(d: &Discovery, v: &Run) -> Vec<SecondRun> {
     d.terms
         .iter()
         .enumerate()
-        .filter(|(_, t)| t.carried.is_none())
+        .filter(|(_, t)| t.proposed && t.carried.is_none())
         .map(|(i, _)| {
             let mut m = d.model_after.clone();
             m.terms.remove(i);
@@ -567,8 +587,8 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
         let ps = term_params_text(t);
         match &t.carried {
             None => println!(
-                "found term{} {} ({}): {ps}; it predicts blocks of the record it was not fitted on by {:.1} noise variances (threshold {}, {} folds){}",
-                if t.proposed { ", a proposal outside the physics library:" } else { " written in the model:" },
+                "{} {} ({}): {ps}; it predicts blocks of the record it was not fitted on by {:.1} noise variances (threshold {}, {} folds){}",
+                if t.proposed { "found term, a proposal outside the physics library:" } else { "fitted term written in the model:" },
                 t.term.formula,
                 t.label,
                 t.validation.held_out_gain,
