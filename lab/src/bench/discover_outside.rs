@@ -20,6 +20,10 @@ use std::collections::BTreeMap;
 
 /// Correlation the model's addition must reach with the hidden term.
 pub const MIN_CORRELATION: f64 = 0.95;
+/// Below this RMS (deg/h, a millionth of any gyro's floor) a series is
+/// taken as constant: the model's addition (y_after - y_given) carries
+/// the rounding of the reference rate (1e-10 deg/h), not a shape.
+pub const NEGLIGIBLE_DPH: f64 = 1e-6;
 /// Gap after on A, and residual on B, as multiples of the realised noise.
 pub const GAP_FACTOR: f64 = 1.25;
 pub const PREDICT_FACTOR: f64 = 1.5;
@@ -151,7 +155,11 @@ pub fn score(t: &CaseTruth, e: &Evidence) -> Scored {
         .filter(|n| *n != "term" && !t.expect.contains(n) && !t.allow.contains(n))
         .cloned()
         .collect();
-    let correlation = correlation(&e.added_1s, &e.hidden_1s);
+    let correlation = if rms_about_mean(&e.added_1s) < NEGLIGIBLE_DPH {
+        0.0
+    } else {
+        correlation(&e.added_1s, &e.hidden_1s)
+    };
     let floor_a = t.a.noise_1s_dph;
     let floor_b = t.b.noise_1s_dph;
     let b_rms = rms_about_mean(&e.residual_b_1s);
@@ -263,7 +271,7 @@ mod tests {
             .map(|k| 0.2 * 2f64.sqrt() * ((k as f64) * 2.399_963).sin())
             .collect();
         let h1 = means_1s(&t, &hidden);
-        let added: Vec<f64> = hidden.iter().map(|h| scale_added * h + 0.5).collect();
+        let added: Vec<f64> = hidden.iter().map(|h| scale_added * h).collect();
         let a1 = means_1s(&t, &added);
         // Residual = hidden + noise - added (1 s means).
         let res: Vec<f64> = (0..n).map(|k| h1[k] + noise_1s[k] - a1[k]).collect();

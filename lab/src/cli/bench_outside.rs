@@ -11,6 +11,8 @@ use crate::bench::discover_outside::{
 };
 use crate::cli::args::Json;
 use crate::cli::output::progress_bar;
+use crate::cli::simulate::outside::HIDDEN_COLUMN;
+use crate::data::run_file::Column;
 use crate::data::table::ColumnStream;
 use crate::error::LabError;
 use crate::model::discovery::discover;
@@ -34,7 +36,7 @@ pub struct OutsideBenchArgs {
 
 /// The hidden term per row, deg/h, from its side file.
 fn read_hidden(path: &Path) -> Result<(Vec<f64>, Vec<f64>), LabError> {
-    let mut c = ColumnStream::read(path, &["t_s", "hidden_dph"])?;
+    let mut c = ColumnStream::read(path, &[Column::Time.name(), HIDDEN_COLUMN])?;
     let h = c.data.pop().unwrap_or_default();
     let t = c.data.pop().unwrap_or_default();
     Ok((t, h))

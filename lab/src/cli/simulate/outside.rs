@@ -15,6 +15,9 @@ use crate::sim::outside_run::{outside_set, OutsideCase, OutsideRun};
 use clap::Args;
 use std::path::Path;
 
+/// The side file's column of the hidden term, deg/h.
+pub const HIDDEN_COLUMN: &str = "hidden_dph";
+
 #[derive(Args, Debug, Clone)]
 pub struct OutsideArgs {
     #[command(flatten)]
@@ -24,7 +27,7 @@ pub struct OutsideArgs {
     pub out: Out,
     /// Cases per kind (21 kinds: 10 physical terms, 4 events, 4 nulls, 3
     /// library effects), each two runs.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 2)]
     pub per_kind: usize,
     #[command(flatten)]
     pub json: Json,
@@ -87,7 +90,7 @@ fn write_hidden(c: &OutsideCase, r: &OutsideRun, path: &Path) -> Result<(), LabE
             "gyro-lab simulate outside: {}: the hidden term's contribution per row (deg/h)",
             c.name
         ),
-        &[("t_s", Shortest), ("hidden_dph", Exp(10))],
+        &[(Column::Time.name(), Shortest), (HIDDEN_COLUMN, Exp(10))],
     )?;
     for (t, h) in r.t.iter().zip(&r.hidden_dph) {
         w.row(&[*t, *h])?;

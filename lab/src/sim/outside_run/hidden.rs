@@ -9,6 +9,7 @@
 //! mid-run.
 
 use super::profiles::State;
+use super::thermal::Temp;
 use std::collections::BTreeMap;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -144,8 +145,15 @@ impl Hidden {
     /// The shape for a unit coefficient, deg/h per row.
     pub fn shape(self, st: &State) -> Vec<f64> {
         let n = st.t.len();
-        let coil = || st.coil.as_ref().expect("a FOG profile has a coil");
-        let case = || st.case.as_ref().expect("an RLG profile has a case");
+        // A state without the temperature a term needs (a recipe's
+        // mismatch, never drawn) reads zeros rather than panicking.
+        let zero = Temp {
+            v: vec![0.0; n],
+            d1: vec![0.0; n],
+            d2: vec![0.0; n],
+        };
+        let coil = || st.coil.as_ref().unwrap_or(&zero);
+        let case = || st.case.as_ref().unwrap_or(&zero);
         let per = |f: &dyn Fn(usize) -> f64| (0..n).map(f).collect::<Vec<f64>>();
         match self {
             Hidden::None => vec![0.0; n],
@@ -159,7 +167,7 @@ impl Hidden {
             Hidden::CoilCurvature => coil().d2.clone(),
             Hidden::SfTempRate => per(&|k| 1e-6 * DPH * st.w[k] * coil().d1[k]),
             Hidden::CaseMinusMono => {
-                let (a, b) = st.mono.as_ref().expect("an RLG profile has monoblocks");
+                let (a, b) = st.mono.as_ref().map_or((&zero, &zero), |(a, b)| (a, b));
                 per(&|k| case().v[k] - 0.5 * (a.v[k] + b.v[k]))
             }
             Hidden::CaseRate => case().d1.clone(),

@@ -15,10 +15,11 @@
 //! - rate random walk K (deg/h/sqrt(h)): Gaussian increments of
 //!   K/216000 sqrt(dt) deg/s per row;
 //! - first-order Markov noise (sigma, T_c) as its exact AR(1);
-//! - an RLG's angle counts of q arcsec: the angle is counted from a random
-//!   phase of the first count, so a 1 s mean carries q/sqrt(6) deg/h of
-//!   quantisation noise (the difference of two independent uniform
-//!   errors of q: variance 2 q^2/12).
+//! - an RLG's angle counts of q arcsec, read through its dither and
+//!   stripped: each readout's error is uniform over a count and independent
+//!   of the last, so a 1 s mean carries q/sqrt(6) deg/h of quantisation
+//!   noise (the difference of two independent uniform errors of q:
+//!   variance 2 q^2/12).
 
 use super::rng::Rng;
 
@@ -111,22 +112,29 @@ pub fn rate_noise(spec: &NoiseSpec, n: usize, dt: f64, rng: &mut Rng) -> (Vec<f6
     (sum, white)
 }
 
-/// An RLG's counted output: the rate integrated over each row, counted in
-/// whole counts of `q_arcsec`, differenced (deg/s). The counter starts at
-/// a random phase of its first count.
+/// An RLG's counted output, deg/s: the rate integrated over each row and
+/// counted in whole counts of `q_arcsec` through the dither. The dither
+/// angle at each readout is random over many counts (its amplitude noise
+/// randomises it) and stripping subtracts it after counting, so each
+/// readout's counting error is uniform over one count and independent of
+/// the last; the row's rate is the difference of two readouts.
 pub fn count(rate: &[f64], dt: f64, q_arcsec: f64, rng: &mut Rng) -> Vec<f64> {
     if q_arcsec <= 0.0 {
         return rate.to_vec();
     }
     let q = q_arcsec / 3600.0;
-    let mut angle = q * rng.unit();
-    let mut last = (angle / q).floor();
+    let mut angle = 0.0;
+    let read = |angle: f64, rng: &mut Rng| {
+        let dither = 64.0 * q * rng.unit();
+        ((angle + dither) / q).floor() * q - dither
+    };
+    let mut last = read(angle, rng);
     rate.iter()
         .map(|r| {
             angle += r * dt;
-            let c = (angle / q).floor();
-            let out = (c - last) * q / dt;
-            last = c;
+            let now = read(angle, rng);
+            let out = (now - last) / dt;
+            last = now;
             out
         })
         .collect()
