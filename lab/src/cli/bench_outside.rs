@@ -47,7 +47,7 @@ fn one(dir: &Path, t: &CaseTruth) -> Result<Scored, LabError> {
     let run = crate::cli::discover::read_run(&dir.join(&t.a.file))?;
     let g = GyroKind::from_name(&t.gyro).ok_or_else(|| {
         LabError::input(
-            &dir.join("truth.json"),
+            dir.join("truth.json"),
             format!("gyro {:?} unknown", t.gyro),
         )
     })?;
