@@ -49,6 +49,10 @@ pub struct CaseTruth {
     pub expect: Vec<String>,
     #[serde(default)]
     pub allow: Vec<String>,
+    /// The hidden term's coefficient and shape parameters (read only by
+    /// the bench's `--oracle` reference, never by the scoring).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
     pub a: RunTruth,
     pub b: RunTruth,
 }
@@ -255,6 +259,7 @@ mod tests {
                 vec!["term".into()]
             },
             allow: vec!["bias".into()],
+            parameters: BTreeMap::new(),
             a: run.clone(),
             b: run,
         }

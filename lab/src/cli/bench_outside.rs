@@ -30,6 +30,13 @@ pub struct OutsideBenchArgs {
     /// Threads (default: the cores available).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Instead of discovery, each kind's right formula in the term
+    /// language with the truth's shape parameters, only its coefficient
+    /// and a bias fitted on run A (least squares): whether a case can be
+    /// explained from the run file's columns at all. A reference for
+    /// discovery, not a score of it.
+    #[arg(long)]
+    pub oracle: bool,
     #[command(flatten)]
     pub json: Json,
 }
@@ -42,29 +49,160 @@ fn read_hidden(path: &Path) -> Result<(Vec<f64>, Vec<f64>), LabError> {
     Ok((t, h))
 }
 
-/// Discovery on a case's run A, and the model it writes on run B.
-fn one(dir: &Path, t: &CaseTruth) -> Result<Scored, LabError> {
+/// The oracle's formula for a kind (unit coefficient, deg/h) on the run
+/// file's columns, and the truth's shape parameters it names; None for a
+/// null. Written with placeholders for the columns ({w} rate, {T} coil,
+/// {case}, {a}, {b} the RLG's sensors, {acc}, {t} time).
+fn oracle_formula(kind: &str) -> Option<(String, Vec<&'static str>)> {
+    let (f, p): (&str, Vec<&'static str>) = match kind {
+        "w2" => ("{w}^2", vec![]),
+        "w3" => ("{w}^3", vec![]),
+        "w_abs_w" => ("{w} * abs({w})", vec![]),
+        "bias_temp_quadratic" => ("({T} - t0_c)^2", vec!["t0_c"]),
+        "sf_temp_quadratic" => ("{w} * ({T} - t0_c)^2", vec!["t0_c"]),
+        "coil_curvature" => ("d2dt2({T})", vec![]),
+        "sf_temp_rate" => ("{w} * ddt({T})", vec![]),
+        "case_minus_mono" => ("{case} - ({a} + {b})/2", vec![]),
+        "case_rate" => ("ddt({case})", vec![]),
+        "abs_acc" => ("abs({acc})", vec![]),
+        // (1 + tanh(x/r))/2 = 1/(1 + exp(-2x/r)).
+        "step" => (
+            "1/(1 + exp(-2*({t} - t0_s)/rise_s))",
+            vec!["t0_s", "rise_s"],
+        ),
+        "periodic" => (
+            "sin(2*pi*{t}/period_s + phase_rad)",
+            vec!["period_s", "phase_rad"],
+        ),
+        "ageing_ramp" => ("({t} - t1_s) * step({t} - t1_s)", vec!["t1_s"]),
+        "settling" => (
+            "(1 - exp(-({t} - t1_s)/tau_s)) * step({t} - t1_s)",
+            vec!["t1_s", "tau_s"],
+        ),
+        "lib_scale_factor_error" => ("{w}", vec![]),
+        "lib_bias_temperature" => ("{T} - 20", vec![]),
+        "lib_case_temperature" => ("{case} - 20", vec![]),
+        _ => return None,
+    };
+    let mut f = f.to_owned();
+    for (k, c) in [
+        ("{w}", Column::RefRate),
+        ("{T}", Column::Temp),
+        ("{case}", Column::Case),
+        ("{a}", Column::MonoA),
+        ("{b}", Column::MonoB),
+        ("{acc}", Column::RefAcc),
+        ("{t}", Column::Time),
+    ] {
+        f = f.replace(k, c.name());
+    }
+    Some((f, p))
+}
+
+/// The oracle's model on run A: a bias and the kind's formula, their
+/// coefficients by least squares; with the names a tool would print.
+fn oracle_model(
+    g: GyroKind,
+    t: &CaseTruth,
+    run: &crate::model::discovery::Run,
+) -> Result<(Model, Vec<String>, f64), LabError> {
+    use crate::model::term::Term;
+    let inp = &run.inputs;
+    let y: Vec<f64> = run
+        .rate
+        .iter()
+        .zip(&inp.w)
+        .map(|(r, w)| (r - w) * 3600.0)
+        .collect();
+    let n = y.len() as f64;
+    let mut m = Model::ideal(g);
+    let (shape, params) = match oracle_formula(&t.kind) {
+        Some((f, names)) => {
+            let p: BTreeMap<String, f64> = names
+                .iter()
+                .map(|k| {
+                    (
+                        k.to_string(),
+                        t.parameters.get(*k).copied().unwrap_or(f64::NAN),
+                    )
+                })
+                .collect();
+            let term = Term::new(&f, p.clone())
+                .map_err(|e| LabError::Bench(format!("oracle formula {f}: {}", e.msg)))?;
+            let s = term
+                .evaluate(inp)
+                .map_err(|e| LabError::Bench(format!("oracle formula {f}: {e:?}")))?;
+            (Some((f, s)), p)
+        }
+        None => (None, BTreeMap::new()),
+    };
+    let my = y.iter().sum::<f64>() / n;
+    let (b, named) = match &shape {
+        Some((f, s)) => {
+            // y = b + k s: the 2 x 2 normal equations about the means.
+            let ms = s.iter().sum::<f64>() / n;
+            let (mut sxy, mut sxx) = (0.0, 0.0);
+            for (yi, si) in y.iter().zip(s) {
+                sxy += (si - ms) * (yi - my);
+                sxx += (si - ms) * (si - ms);
+            }
+            let k = sxy / sxx;
+            let mut p = params.clone();
+            p.insert("k_oracle".into(), k);
+            let term = Term::new(&format!("k_oracle * ({f})"), p)
+                .map_err(|e| LabError::Bench(format!("oracle formula {f}: {}", e.msg)))?;
+            m.terms.push(term);
+            let names = if t.category == "library" {
+                t.expect.clone()
+            } else {
+                vec!["term".to_owned()]
+            };
+            (my - k * ms, names)
+        }
+        None => (my, vec![]),
+    };
+    let bias = Term::new("b_oracle", [("b_oracle".to_owned(), b)].into())
+        .map_err(|e| LabError::Bench(format!("oracle bias: {}", e.msg)))?;
+    m.terms.push(bias);
+    let r: Vec<f64> = run
+        .rate
+        .iter()
+        .zip(m.evaluate(inp))
+        .map(|(a, b)| (a - b) * 3600.0)
+        .collect();
+    let r1 = means_1s(&inp.t, &r);
+    let gap = (r1.iter().map(|x| x * x).sum::<f64>() / r1.len().max(1) as f64).sqrt();
+    let mut named = named;
+    named.insert(0, "bias".to_owned());
+    Ok((m, named, gap))
+}
+
+/// Discovery (or the oracle) on a case's run A, and the model it writes
+/// on run B.
+fn one(dir: &Path, t: &CaseTruth, oracle: bool) -> Result<Scored, LabError> {
     let run = crate::cli::discover::read_run(&dir.join(&t.a.file))?;
     let g = GyroKind::from_name(&t.gyro).ok_or_else(|| {
-        LabError::input(
-            dir.join("truth.json"),
-            format!("gyro {:?} unknown", t.gyro),
-        )
+        LabError::input(dir.join("truth.json"), format!("gyro {:?} unknown", t.gyro))
     })?;
     let given = Model::ideal(g);
-    let d = discover(&given, &run, &Default::default());
-    let j = crate::cli::discover::json(&d);
-    let named: Vec<String> = j["found"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(|f| f["effect"].as_str().map(str::to_owned))
-                .collect()
-        })
-        .unwrap_or_default();
+    let (model_after, named, gap_after, tool_floor) = if oracle {
+        let (m, named, gap) = oracle_model(g, t, &run)?;
+        (m, named, gap, f64::NAN)
+    } else {
+        let d = discover(&given, &run, &Default::default());
+        let j = crate::cli::discover::json(&d);
+        let named: Vec<String> = j["found"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|f| f["effect"].as_str().map(str::to_owned))
+                    .collect()
+            })
+            .unwrap_or_default();
+        (d.model_after, named, d.gap_after_dph, d.noise_floor_dph)
+    };
     let inp = &run.inputs;
-    let added: Vec<f64> = d
-        .model_after
+    let added: Vec<f64> = model_after
         .evaluate(inp)
         .iter()
         .zip(given.evaluate(inp))
@@ -79,7 +217,7 @@ fn one(dir: &Path, t: &CaseTruth) -> Result<Scored, LabError> {
         ));
     }
     let rb = crate::cli::discover::read_run(&dir.join(&t.b.file))?;
-    let yb = d.model_after.evaluate(&rb.inputs);
+    let yb = model_after.evaluate(&rb.inputs);
     let res_b: Vec<f64> = rb
         .rate
         .iter()
@@ -90,8 +228,8 @@ fn one(dir: &Path, t: &CaseTruth) -> Result<Scored, LabError> {
         named,
         added_1s: means_1s(&inp.t, &added),
         hidden_1s: means_1s(&inp.t, &hidden),
-        gap_after_dph: d.gap_after_dph,
-        tool_floor_dph: d.noise_floor_dph,
+        gap_after_dph: gap_after,
+        tool_floor_dph: tool_floor,
         residual_b_1s: means_1s(&rb.inputs.t, &res_b),
     };
     Ok(score(t, &e))
@@ -207,7 +345,7 @@ pub fn run_bench(a: &OutsideBenchArgs) -> Result<(), LabError> {
                     (k..truth.len())
                         .step_by(threads)
                         .map(|i| {
-                            let r = one(dir, &truth[i]);
+                            let r = one(dir, &truth[i], a.oracle);
                             bar.inc(1);
                             (i, r)
                         })
@@ -231,6 +369,9 @@ pub fn run_bench(a: &OutsideBenchArgs) -> Result<(), LabError> {
     }
     let tot = totals(&scored);
     if !a.json.json {
+        if a.oracle {
+            println!("ORACLE: each kind's right formula with the truth's shape parameters, coefficient and bias fitted on run A (not discovery)");
+        }
         print_table(&a.runs, &scored, &tot);
         return Ok(());
     }
@@ -238,6 +379,7 @@ pub fn run_bench(a: &OutsideBenchArgs) -> Result<(), LabError> {
         "{}",
         serde_json::json!({
             "cases": scored.len(),
+            "oracle": a.oracle,
             "totals": tot,
             "rules": {
                 "min_correlation": MIN_CORRELATION,
