@@ -65,9 +65,10 @@ fn oracle_formula(kind: &str) -> Option<(String, Vec<&'static str>)> {
         "case_minus_mono" => ("{case} - ({a} + {b})/2", vec![]),
         "case_rate" => ("ddt({case})", vec![]),
         "abs_acc" => ("abs({acc})", vec![]),
-        // (1 + tanh(x/r))/2 = 1/(1 + exp(-2x/r)).
+        // (1 + tanh(x/r))/2 = (step(x) + (1 - step(x)) e)/(1 + e) with
+        // e = exp(-2|x|/r): never overflows.
         "step" => (
-            "1/(1 + exp(-2*({t} - t0_s)/rise_s))",
+            "(step({t} - t0_s) + (1 - step({t} - t0_s)) * exp(-2*abs({t} - t0_s)/rise_s)) / (1 + exp(-2*abs({t} - t0_s)/rise_s))",
             vec!["t0_s", "rise_s"],
         ),
         "periodic" => (
@@ -173,7 +174,11 @@ fn oracle_model(
     let r1 = means_1s(&inp.t, &r);
     let gap = (r1.iter().map(|x| x * x).sum::<f64>() / r1.len().max(1) as f64).sqrt();
     let mut named = named;
-    named.insert(0, "bias".to_owned());
+    if t.category != "null" {
+        // The fitted constant is a bias the truth allows; on a null the
+        // oracle names nothing (its constant stands for the carried one).
+        named.insert(0, "bias".to_owned());
+    }
     Ok((m, named, gap))
 }
 
