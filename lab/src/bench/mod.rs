@@ -3,12 +3,13 @@
 //! (allan.rs), the eps^2 correction over the vibration envelope (eps2.rs),
 //! discovery (discover_trials.rs, discover_categories.rs,
 //! discover_summary.rs; discover_heldout.rs scores the second generator's
-//! held-out set), the dithered RLG's random walk and rate error
-//! (dither.rs). Each returns its figures; the bench command prints them.
+//! held-out set, discover_outside.rs the outside generator's cases), the
+//! dithered RLG's random walk and rate error (dither.rs). Each returns its figures; the bench command prints them.
 
 pub mod allan;
 pub mod discover_categories;
 pub mod discover_heldout;
+pub mod discover_outside;
 pub mod discover_summary;
 pub mod discover_trials;
 pub mod dither;

@@ -34,6 +34,8 @@ pub enum BenchCmd {
     Record(crate::cli::bench_record::RecordBenchArgs),
     /// Discovery on the second generator's held-out set (`simulate heldout`): right, false names, coverage.
     DiscoverHeldout(crate::cli::discover::bench::HeldOutBenchArgs),
+    /// Discovery beyond the library on the outside generator's cases (`simulate outside`): terms explained, run B predicted, nulls clean, library names kept.
+    DiscoverOutside(crate::cli::bench_outside::OutsideBenchArgs),
     /// The online eps^2 correction over the vibration envelope: the table of issue 23.
     Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
     /// The dithered RLG through the firmware's stripping: ARW against the physics, rate error through the lock-in zones.
@@ -49,6 +51,7 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::Discover(a) => crate::cli::discover::bench::discover(a),
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
         BenchCmd::DiscoverHeldout(a) => crate::cli::discover::bench::discover_heldout(a),
+        BenchCmd::DiscoverOutside(a) => crate::cli::bench_outside::run_bench(a),
         BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
         BenchCmd::Dither(a) => crate::cli::bench_dither::run_bench(a),
     }

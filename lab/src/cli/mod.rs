@@ -9,6 +9,7 @@ pub mod args;
 pub mod bench;
 pub mod bench_dither;
 pub mod bench_eps2;
+pub mod bench_outside;
 pub mod bench_record;
 pub mod compensate;
 pub mod discover;

@@ -7,7 +7,9 @@
 //! noise (model_run.rs), records of known noise terms (noise_run.rs, and
 //! by other algorithms independent_noise.rs), a second generator written
 //! apart from the project's for discovery's held-out set (heldout_run/),
-//! a third written apart from both (third_run/)
+//! a third written apart from both (third_run/), a fourth for terms
+//! outside discovery's library, each case two runs of one gyro
+//! (outside_run/)
 //! and the byte stream a board sends (board_stream.rs).
 
 pub mod board_stream;
@@ -20,5 +22,6 @@ pub mod heldout_run;
 pub mod independent_noise;
 pub mod model_run;
 pub mod noise_run;
+pub mod outside_run;
 pub mod scale_factor_rig;
 pub mod third_run;

@@ -6,6 +6,7 @@ pub mod dither;
 pub mod fog;
 pub mod heldout;
 pub mod lockin;
+pub mod outside;
 pub mod run;
 pub mod scale_factor;
 
@@ -28,6 +29,8 @@ pub enum SimulateCmd {
     Run(run::SimulateRunArgs),
     /// The second, independent generator's held-out set for discovery (runs and truth.json).
     Heldout(heldout::HeldOutArgs),
+    /// The outside generator's cases for discovery beyond the library: two runs of one gyro per case, their hidden terms and truth.json.
+    Outside(outside::OutsideArgs),
 }
 
 pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
@@ -39,5 +42,6 @@ pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
         SimulateCmd::ScaleFactor(a) => scale_factor::run(a),
         SimulateCmd::Run(a) => run::run(a),
         SimulateCmd::Heldout(a) => heldout::run(a),
+        SimulateCmd::Outside(a) => outside::run(a),
     }
 }
