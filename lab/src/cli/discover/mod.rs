@@ -12,7 +12,7 @@ use crate::data::residual_file;
 use crate::data::run_file::{Column, RunFile};
 use crate::error::LabError;
 use crate::model::discovery::estimates::Estimate;
-use crate::model::discovery::outside::TermFound;
+use crate::model::discovery::result::TermFound;
 use crate::model::discovery::terms::Kind;
 use crate::model::discovery::{discover, discover_library, Discovery, Options, Run, WINDOW_S};
 use crate::model::effects::Effect;

@@ -28,6 +28,7 @@ pub mod noise_model;
 pub mod normal;
 pub mod outside;
 pub mod projection;
+pub mod result;
 pub mod select;
 pub mod terms;
 pub mod transients;
@@ -35,24 +36,23 @@ pub mod unexplained;
 pub mod white;
 pub mod windows;
 
-use crate::data::run_file::Column;
 use crate::model::effects::Effect;
 use crate::model::grade::{Grade, GradeChoice};
 use crate::model::gyro_kind::GyroKind;
 use crate::model::gyro_model::{Model, ModelEffect};
 use crate::model::inputs::Inputs;
 use crate::model::ranges::Extent;
-use crate::noise::analysis::Allan;
 use constant::Role;
 use design::{inflation, Design};
 use estimates::{estimate, Estimate};
-use noise_floor::{allan_of, disagreements, expected_gap, gap, noise_floor, Disagreement};
+use noise_floor::{allan_of, disagreements, expected_gap, gap, noise_floor};
 use noise_model::{NoiseModel, Whitener, MIN_COLOUR_WINDOWS};
-use select::{select, Ambiguous, Implausible, Selection};
+pub use result::{Carried, Discovery, Options, Run, Skipped, NOT_SIGNIFICANT};
+use select::{select, Selection};
 use std::collections::BTreeMap;
 use terms::{rotating, Kind, Term};
 use transients::Transients;
-use unexplained::{assess, Sources, Unexplained};
+use unexplained::{assess, Sources};
 use windows::Windows;
 
 /// The gap's averaging, s.
@@ -62,88 +62,9 @@ pub const SMOOTH_S: f64 = 60.0;
 /// Most passes of the selection.
 pub const MAX_PASSES: usize = 4;
 
-/// A run's inputs and measured rate (deg/s).
-pub struct Run {
-    pub inputs: Inputs,
-    pub rate: Vec<f64>,
-}
-
-/// What the user sets.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Options {
-    /// The gyro's grade (`--grade`); judged from the run's white noise
-    /// when None.
-    pub grade: Option<Grade>,
-}
-
 /// The least rate, deg/s, a run must reach beyond the Earth rate (0.004
 /// deg/s) for lock-in to show: a lock-in rate below it is not an RLG's.
 pub const LOCK_IN_MIN_DPS: f64 = 0.01;
-
-/// An effect of the library the run cannot show, and why.
-#[derive(Clone, Debug)]
-pub struct Skipped {
-    pub effect: Effect,
-    /// The columns it needs that the run lacks (empty: another reason).
-    pub missing: &'static [Column],
-    pub reason: String,
-}
-
-/// An effect carried in the model without being named, and why.
-#[derive(Clone, Debug)]
-pub struct Carried {
-    pub estimate: Estimate,
-    pub why: String,
-}
-
-pub struct Discovery {
-    pub gyro: GyroKind,
-    pub grade: GradeChoice,
-    /// Named effects, in the order they came in (a bias first).
-    pub found: Vec<Estimate>,
-    pub carried: Vec<Carried>,
-    pub ambiguous: Vec<Ambiguous>,
-    pub implausible: Vec<Implausible>,
-    pub unexplained: Option<Unexplained>,
-    /// Effects the backward steps removed after they came in.
-    pub dropped: Vec<String>,
-    /// Effects, terms no effect explains, and the constant (as
-    /// `Kind::Constant`) that paid on the selection's noise but not once
-    /// the noise was re-fitted without them (confirm.rs), with what they
-    /// gained then (below the threshold).
-    pub not_confirmed: Vec<(Kind, f64)>,
-    pub skipped: Vec<Skipped>,
-    pub residual_before: Vec<f64>,
-    pub residual_after: Vec<f64>,
-    pub windows: Windows,
-    pub gap_before_dph: f64,
-    pub gap_after_dph: f64,
-    /// The gap the noise alone leaves (noise_floor.rs's `expected_gap`,
-    /// slow levels capped at the grade's), its upper bound (slow levels at
-    /// their 95 % bounds, three standard deviations), and the white floor
-    /// of 1 s means the first pass starts from, deg/h.
-    pub noise_floor_dph: f64,
-    pub noise_floor_hi_dph: f64,
-    pub noise_floor_white_dph: f64,
-    pub noise: NoiseModel,
-    pub passes: usize,
-    /// Set when the joint fit's parameters would have widened the gap and
-    /// the model written was re-fitted without the unexplained terms.
-    pub fallback: Option<String>,
-    /// Set on a record too short for its intervals (fewer than
-    /// [`MIN_COLOUR_WINDOWS`] windows): why they are not to be relied on.
-    pub short: Option<String>,
-    pub disagreements: Vec<Disagreement>,
-    pub model_after: Model,
-    pub allan_before: Option<Allan>,
-    pub allan_after: Option<Allan>,
-    /// The windows the final fit used (transients left out).
-    pub keep: Vec<bool>,
-    /// The model's terms outside the library (outside.rs): a user's,
-    /// fitted, and those proposed.
-    pub terms: Vec<outside::TermFound>,
-    pub proposals: outside::Proposals,
-}
 
 /// Measured minus the model's output, deg/s.
 fn residual(model: &Model, run: &Run) -> Vec<f64> {
@@ -374,10 +295,6 @@ fn allow_slow_noise(
     }
 }
 
-/// Why an effect whose interval holds zero is carried, not named.
-pub const NOT_SIGNIFICANT: &str =
-    "its 95 % interval holds zero (or the record gives it none), so the data do not show it";
-
 /// Whether `e`'s 95 % interval holds zero: every linear parameter's, or,
 /// for an effect with none (lock-in), its non-linear one's; an interval
 /// the record cannot give (NaN) holds it too.
@@ -471,7 +388,7 @@ fn window_spacing(win: &Windows) -> f64 {
 /// and after, and what stays unexplained.
 pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let first = discover_library(model, run, opts);
-    outside::beyond(model, run, opts, first)
+    outside::beyond(model, run, opts, first, &discover_library)
 }
 
 /// [`discover`] with the library's effects alone (the model's terms held

@@ -10,15 +10,19 @@
 //! before stays the model given's.
 
 use super::noise_model::Whitener;
+use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
 use super::select::Implausible;
-use super::{discover_library, Discovery, Options, Run};
 use crate::model::effects::Effect;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
 use crate::model::proposal::refit::{fit_term, is_linear};
-use crate::model::proposal::{propose, Tried, Validation};
+use crate::model::proposal::{propose, Validation};
 use crate::model::term::Term;
 use std::collections::BTreeMap;
+
+/// The library's discovery (mod.rs's `discover_library`), given by the
+/// caller.
+pub type Library<'a> = &'a dyn Fn(&Model, &Run, &Options) -> Discovery;
 
 /// Most terms proposed on one run.
 pub const MAX_PROPOSED: usize = 2;
@@ -33,36 +37,6 @@ pub const MIN_GAP_OVER_FLOOR: f64 = 1.5;
 /// The least share of the gap's excess over the noise floor (in variance)
 /// a proposed term must close.
 pub const MIN_CLOSED: f64 = 0.5;
-
-/// A term of the model written that is not a library effect.
-#[derive(Clone, Debug)]
-pub struct TermFound {
-    /// What a gyro engineer would call it ("written in the model" for a
-    /// user's own).
-    pub label: String,
-    pub term: Term,
-    /// 95 % intervals of its parameters.
-    pub intervals: BTreeMap<String, (f64, f64)>,
-    pub validation: Validation,
-    /// Proposed by discover; false: written in the model given.
-    pub proposed: bool,
-    /// Why it is carried and not named (None: named).
-    pub carried: Option<String>,
-    /// The library effect whose shape it is, with what keeps that effect
-    /// from being named.
-    pub disguise: Option<String>,
-    /// A proposed term's effect on the gap after: without it, with it
-    /// (deg/h), and the share of the excess over the floor it closed.
-    pub closure: Option<(f64, f64, f64)>,
-}
-
-/// What the proposal tried on the run (the last attempt), and why it
-/// stopped where it did.
-#[derive(Clone, Debug, Default)]
-pub struct Proposals {
-    pub tried: Vec<Tried>,
-    pub note: Option<String>,
-}
 
 /// The whitened rows of per-row columns in deg/h, under `d`'s noise.
 struct Rows<'a> {
@@ -252,6 +226,7 @@ fn refit_users(
     run: &Run,
     opts: &Options,
     users: usize,
+    discover_library: Library,
 ) -> (Model, Discovery) {
     for _ in 0..2 {
         let mut next_m = m.clone();
@@ -277,7 +252,13 @@ fn refit_users(
 
 /// Discovery with the terms beyond the library: `first` is the library's
 /// discovery on `given`.
-pub fn beyond(given: &Model, run: &Run, opts: &Options, mut first: Discovery) -> Discovery {
+pub fn beyond(
+    given: &Model,
+    run: &Run,
+    opts: &Options,
+    mut first: Discovery,
+    discover_library: Library,
+) -> Discovery {
     let inp = &run.inputs;
     if first.short.is_some() {
         return first;
@@ -290,7 +271,15 @@ pub fn beyond(given: &Model, run: &Run, opts: &Options, mut first: Discovery) ->
     let allan_before = first.allan_before.take();
     let disagreements = std::mem::take(&mut first.disagreements);
     let (mut m, mut cur) = if users > 0 {
-        refit_users(given, given.clone(), first, run, opts, users)
+        refit_users(
+            given,
+            given.clone(),
+            first,
+            run,
+            opts,
+            users,
+            discover_library,
+        )
     } else {
         (given.clone(), first)
     };
@@ -401,7 +390,7 @@ pub fn beyond(given: &Model, run: &Run, opts: &Options, mut first: Discovery) ->
             }
         }
         let carried = if !significant(&t, &intervals, inp) {
-            Some(format!("not named: {}", super::NOT_SIGNIFICANT))
+            Some(format!("not named: {}", NOT_SIGNIFICANT))
         } else if !(validation.held_out_gain >= validation.threshold) {
             Some(format!(
                 "not named: refitted on blocks of the record, it predicts the others by {:.1} noise variances, below the threshold of {}",

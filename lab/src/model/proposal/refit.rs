@@ -72,6 +72,27 @@ fn jacobian(t: &Term, free: &[String], inp: &Inputs, rows: ToRows) -> Option<Vec
         .collect()
 }
 
+/// Solves a x = c (m x m) with the parameters whose column is nil held
+/// (their step 0): a coefficient at zero leaves its shape parameter no
+/// column until the coefficient moves.
+fn solve_held(a: &[f64], c: &[f64]) -> Option<Vec<f64>> {
+    let m = c.len();
+    let big = (0..m).map(|i| a[i * m + i]).fold(0.0, f64::max);
+    let mut a = a.to_vec();
+    let mut c = c.to_vec();
+    for i in 0..m {
+        if a[i * m + i] <= 1e-12 * big {
+            for j in 0..m {
+                a[i * m + j] = 0.0;
+                a[j * m + i] = 0.0;
+            }
+            a[i * m + i] = 1.0;
+            c[i] = 0.0;
+        }
+    }
+    solve(&a, &c)
+}
+
 /// `x` less its projection on the orthonormal `q`.
 fn orthogonal(mut x: Vec<f64>, q: &[Vec<f64>]) -> Vec<f64> {
     for u in q {
@@ -111,7 +132,7 @@ pub fn fit_term(
             .collect();
         let a: Vec<f64> = (0..m * m).map(|k| dot(&j[k / m], &j[k % m])).collect();
         let c: Vec<f64> = j.iter().map(|c| dot(c, &r)).collect();
-        let step = solve(&a, &c)?;
+        let step = solve_held(&a, &c)?;
         let mut lambda = 1.0;
         let mut moved = false;
         for _ in 0..20 {
@@ -147,8 +168,8 @@ pub fn fit_term(
     for (i, p) in free.iter().enumerate() {
         let mut e = vec![0.0; m];
         e[i] = 1.0;
-        let inv = solve(&a, &e)?;
-        let se = (var * inv[i]).max(0.0).sqrt();
+        // A parameter the record cannot fix gets no interval (NaN).
+        let se = solve(&a, &e).map_or(f64::NAN, |inv| (var * inv[i]).max(0.0).sqrt());
         let v = cur.params[p];
         intervals.insert(p.clone(), (v - 1.96 * se, v + 1.96 * se));
     }
@@ -194,6 +215,7 @@ pub fn fit_term(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::data::run_file::Column;
     use rand_core::SeedableRng;
     use rand_distr::{Distribution, StandardNormal};
 
@@ -225,7 +247,11 @@ mod tests {
             .collect();
         let params: BTreeMap<String, f64> =
             [("k_dph".to_string(), 0.0), ("tau_s".to_string(), 900.0)].into();
-        let t = Term::new("k_dph * exp(-t_s / tau_s)", params).unwrap();
+        let t = Term::new(
+            &format!("k_dph * exp(-{} / tau_s)", Column::Time.name()),
+            params,
+        )
+        .unwrap();
         let free = vec!["k_dph".to_string(), "tau_s".to_string()];
         let f = fit_term(&t, &free, &inp, &y, &[vec![1.0; n]], &|x| x.to_vec()).unwrap();
         for (p, truth) in [("k_dph", 6.0), ("tau_s", 1500.0)] {
@@ -240,7 +266,11 @@ mod tests {
         let inp = run(1000);
         let params: BTreeMap<String, f64> =
             [("k_dph".to_string(), 1.0), ("tau_s".to_string(), 900.0)].into();
-        let t = Term::new("k_dph * exp(-t_s / tau_s)", params).unwrap();
+        let t = Term::new(
+            &format!("k_dph * exp(-{} / tau_s)", Column::Time.name()),
+            params,
+        )
+        .unwrap();
         assert!(is_linear(&t, "k_dph", &inp));
         assert!(!is_linear(&t, "tau_s", &inp));
     }

@@ -1,0 +1,136 @@
+//! What a discovery gives: the run it reads, the options, and the
+//! discovery itself (the effects found and carried, the terms outside the
+//! library, the residual before and after, what is left). Apart from the
+//! passes that make it (mod.rs) and the terms beyond the library
+//! (outside.rs), which both build it.
+
+use super::estimates::Estimate;
+use super::noise_floor::Disagreement;
+use super::noise_model::NoiseModel;
+use super::select::{Ambiguous, Implausible};
+use super::terms::Kind;
+use super::unexplained::Unexplained;
+use super::windows::Windows;
+use crate::data::run_file::Column;
+use crate::model::effects::Effect;
+use crate::model::grade::{Grade, GradeChoice};
+use crate::model::gyro_kind::GyroKind;
+use crate::model::gyro_model::Model;
+use crate::model::inputs::Inputs;
+use crate::model::proposal::{Tried, Validation};
+use crate::model::term::Term;
+use crate::noise::analysis::Allan;
+use std::collections::BTreeMap;
+
+/// A run's inputs and measured rate (deg/s).
+pub struct Run {
+    pub inputs: Inputs,
+    pub rate: Vec<f64>,
+}
+
+/// What the user sets.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// The gyro's grade (`--grade`); judged from the run's white noise
+    /// when None.
+    pub grade: Option<Grade>,
+}
+
+/// An effect of the library the run cannot show, and why.
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    pub effect: Effect,
+    /// The columns it needs that the run lacks (empty: another reason).
+    pub missing: &'static [Column],
+    pub reason: String,
+}
+
+/// An effect carried in the model without being named, and why.
+#[derive(Clone, Debug)]
+pub struct Carried {
+    pub estimate: Estimate,
+    pub why: String,
+}
+
+pub struct Discovery {
+    pub gyro: GyroKind,
+    pub grade: GradeChoice,
+    /// Named effects, in the order they came in (a bias first).
+    pub found: Vec<Estimate>,
+    pub carried: Vec<Carried>,
+    pub ambiguous: Vec<Ambiguous>,
+    pub implausible: Vec<Implausible>,
+    pub unexplained: Option<Unexplained>,
+    /// Effects the backward steps removed after they came in.
+    pub dropped: Vec<String>,
+    /// Effects, terms no effect explains, and the constant (as
+    /// `Kind::Constant`) that paid on the selection's noise but not once
+    /// the noise was re-fitted without them (confirm.rs), with what they
+    /// gained then (below the threshold).
+    pub not_confirmed: Vec<(Kind, f64)>,
+    pub skipped: Vec<Skipped>,
+    pub residual_before: Vec<f64>,
+    pub residual_after: Vec<f64>,
+    pub windows: Windows,
+    pub gap_before_dph: f64,
+    pub gap_after_dph: f64,
+    /// The gap the noise alone leaves (noise_floor.rs's `expected_gap`,
+    /// slow levels capped at the grade's), its upper bound (slow levels at
+    /// their 95 % bounds, three standard deviations), and the white floor
+    /// of 1 s means the first pass starts from, deg/h.
+    pub noise_floor_dph: f64,
+    pub noise_floor_hi_dph: f64,
+    pub noise_floor_white_dph: f64,
+    pub noise: NoiseModel,
+    pub passes: usize,
+    /// Set when the joint fit's parameters would have widened the gap and
+    /// the model written was re-fitted without the unexplained terms.
+    pub fallback: Option<String>,
+    /// Set on a record too short for its intervals (fewer than
+    /// [`MIN_COLOUR_WINDOWS`] windows): why they are not to be relied on.
+    pub short: Option<String>,
+    pub disagreements: Vec<Disagreement>,
+    pub model_after: Model,
+    pub allan_before: Option<Allan>,
+    pub allan_after: Option<Allan>,
+    /// The windows the final fit used (transients left out).
+    pub keep: Vec<bool>,
+    /// The model's terms outside the library (outside.rs): a user's,
+    /// fitted, and those proposed.
+    pub terms: Vec<TermFound>,
+    pub proposals: Proposals,
+}
+
+/// Why an effect whose interval holds zero is carried, not named.
+pub const NOT_SIGNIFICANT: &str =
+    "its 95 % interval holds zero (or the record gives it none), so the data do not show it";
+
+/// A term of the model written that is not a library effect.
+#[derive(Clone, Debug)]
+pub struct TermFound {
+    /// What a gyro engineer would call it ("written in the model" for a
+    /// user's own).
+    pub label: String,
+    pub term: Term,
+    /// 95 % intervals of its parameters.
+    pub intervals: BTreeMap<String, (f64, f64)>,
+    pub validation: Validation,
+    /// Proposed by discover; false: written in the model given.
+    pub proposed: bool,
+    /// Why it is carried and not named (None: named).
+    pub carried: Option<String>,
+    /// The library effect whose shape it is, with what keeps that effect
+    /// from being named.
+    pub disguise: Option<String>,
+    /// A proposed term's effect on the gap after: without it, with it
+    /// (deg/h), and the share of the excess over the floor it closed.
+    pub closure: Option<(f64, f64, f64)>,
+}
+
+/// What the proposal tried on the run (the last attempt), and why it
+/// stopped where it did.
+#[derive(Clone, Debug, Default)]
+pub struct Proposals {
+    pub tried: Vec<Tried>,
+    pub note: Option<String>,
+}
