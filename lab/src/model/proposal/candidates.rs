@@ -157,6 +157,21 @@ pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
                     .collect(),
             }),
         });
+        // A ramp that starts at a time (an ageing that sets in, a drift
+        // after an event), on the steps' grid.
+        c.push(Candidate {
+            label: "ramp from a time",
+            parts: vec![Part {
+                coef: "k_dph",
+                shape: format!("({t} - t0_s) / 3600 * step({t} - t0_s)"),
+            }],
+            searched: Some(Searched {
+                name: "t0_s",
+                grid: (0..n)
+                    .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
+                    .collect(),
+            }),
+        });
         // Sinusoids: two or more periods in the record, down to 5 min.
         if span >= 600.0 {
             c.push(Candidate {
