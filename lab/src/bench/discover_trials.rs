@@ -497,7 +497,9 @@ pub fn trial(t: &Trial) -> Outcome {
         term_corr,
         explained,
         gap_b_dph: gap_b,
-        predicts_b: gap_b.is_finite().then(|| gap_b <= 1.5 * d.noise_floor_dph),
+        predicts_b: gap_b
+            .is_finite()
+            .then_some(gap_b <= 1.5 * d.noise_floor_dph),
         params_ok: worst <= 0.1,
         covered,
         intervals,

@@ -24,6 +24,10 @@ use std::collections::BTreeMap;
 /// caller.
 pub type Library<'a> = &'a dyn Fn(&Model, &Run, &Options) -> Discovery;
 
+/// A proposed term's label, the intervals its search gave and its
+/// validation.
+type ProposedMeta = (String, BTreeMap<String, (f64, f64)>, Validation);
+
 /// Most terms proposed on one run.
 pub const MAX_PROPOSED: usize = 2;
 
@@ -284,7 +288,7 @@ pub fn beyond(
         (given.clone(), first)
     };
     // Proposals: what they were, with their validation.
-    let mut proposed: Vec<(String, BTreeMap<String, (f64, f64)>, Validation)> = vec![];
+    let mut proposed: Vec<ProposedMeta> = vec![];
     let mut log = Proposals::default();
     // Per proposed term: the gap after without and with it, and the share
     // of the excess above the floor it closed.
@@ -391,7 +395,9 @@ pub fn beyond(
         }
         let carried = if !significant(&t, &intervals, inp) {
             Some(format!("not named: {}", NOT_SIGNIFICANT))
-        } else if !(validation.held_out_gain >= validation.threshold) {
+        } else if validation.held_out_gain.is_nan()
+            || validation.held_out_gain < validation.threshold
+        {
             Some(format!(
                 "not named: refitted on blocks of the record, it predicts the others by {:.1} noise variances, below the threshold of {}",
                 validation.held_out_gain, validation.threshold
