@@ -141,37 +141,32 @@ pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
         // Time is since power-on, so a ramp or a settling written on one
         // run reads the same on the next.
         c.push(one("ageing ramp", format!("{t} / 3600")));
-        // Steps: anywhere but the record's first and last 5 % (there a step
-        // is a bias or nothing).
+        // Steps, and ramps that start at a time (an ageing that sets in, a
+        // drift after an event): anywhere but the record's first and last
+        // 5 % (there a step is a bias or nothing), on one grid of onsets.
         let n = 96;
-        c.push(Candidate {
-            label: "step",
-            parts: vec![Part {
-                coef: "k_dph",
-                shape: format!("step({t} - t0_s)"),
-            }],
-            searched: Some(Searched {
-                name: "t0_s",
-                grid: (0..n)
-                    .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
-                    .collect(),
-            }),
-        });
-        // A ramp that starts at a time (an ageing that sets in, a drift
-        // after an event), on the steps' grid.
-        c.push(Candidate {
-            label: "ramp from a time",
-            parts: vec![Part {
-                coef: "k_dph",
-                shape: format!("({t} - t0_s) / 3600 * step({t} - t0_s)"),
-            }],
-            searched: Some(Searched {
-                name: "t0_s",
-                grid: (0..n)
-                    .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
-                    .collect(),
-            }),
-        });
+        let onsets: Vec<f64> = (0..n)
+            .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
+            .collect();
+        for (label, shape) in [
+            ("step", format!("step({t} - t0_s)")),
+            (
+                "ramp from a time",
+                format!("({t} - t0_s) / 3600 * step({t} - t0_s)"),
+            ),
+        ] {
+            c.push(Candidate {
+                label,
+                parts: vec![Part {
+                    coef: "k_dph",
+                    shape,
+                }],
+                searched: Some(Searched {
+                    name: "t0_s",
+                    grid: onsets.clone(),
+                }),
+            });
+        }
         // Sinusoids: two or more periods in the record, down to 5 min.
         if span >= 600.0 {
             c.push(Candidate {
