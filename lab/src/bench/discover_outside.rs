@@ -119,28 +119,7 @@ pub fn means_1s(t: &[f64], x: &[f64]) -> Vec<f64> {
     out
 }
 
-/// Pearson correlation; 0 where either side does not vary (or is not finite).
-pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    if n < 2 {
-        return 0.0;
-    }
-    let ma = a[..n].iter().sum::<f64>() / n as f64;
-    let mb = b[..n].iter().sum::<f64>() / n as f64;
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for k in 0..n {
-        let (x, y) = (a[k] - ma, b[k] - mb);
-        sab += x * y;
-        saa += x * x;
-        sbb += y * y;
-    }
-    let r = sab / (saa * sbb).sqrt();
-    if r.is_finite() {
-        r
-    } else {
-        0.0
-    }
-}
+pub use crate::numerics::stats::pearson as correlation;
 
 /// RMS about the mean (NaN stays NaN: a model that cannot be evaluated
 /// predicts nothing).

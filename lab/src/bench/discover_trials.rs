@@ -382,25 +382,6 @@ fn against_truth(
     (worst, cov, all)
 }
 
-/// Pearson correlation (0 where either side is constant).
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len()) as f64;
-    if n < 3.0 {
-        return 0.0;
-    }
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        ab += (x - ma) * (y - mb);
-        aa += (x - ma) * (x - ma);
-        bb += (y - mb) * (y - mb);
-    }
-    if aa <= 0.0 || bb <= 0.0 {
-        return 0.0;
-    }
-    ab / (aa * bb).sqrt()
-}
-
 /// Runs one trial.
 pub fn trial(t: &Trial) -> Outcome {
     let tr = generate_with(&t.truth, &t.extras, t.profile, t.noise, t.seed, None);
@@ -443,7 +424,8 @@ pub fn trial(t: &Trial) -> Outcome {
     let unexplained = d.unexplained.is_some();
     let terms = d.terms.iter().filter(|x| x.carried.is_none()).count();
     // What the model added against the hidden disturbance (1 s means).
-    let term_corr = correlation(&d.windows.mean(&found_c), &d.windows.mean(&hidden_c));
+    let term_corr =
+        crate::numerics::stats::pearson(&d.windows.mean(&found_c), &d.windows.mean(&hidden_c));
     // Run B of the same gyro: the model written must predict it (up to a
     // bias) to 1.5 times the noise floor.
     let gap_b = if t.extras.is_empty() {

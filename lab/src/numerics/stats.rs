@@ -124,6 +124,30 @@ pub fn batch_mean_se(x: &[f64], batches: usize) -> Option<(f64, f64)> {
     Some((m, (var / b as f64).sqrt()))
 }
 
+/// Pearson correlation; 0 where either side does not vary (or is not
+/// finite).
+pub fn pearson(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    if n < 2 {
+        return 0.0;
+    }
+    let ma = a[..n].iter().sum::<f64>() / n as f64;
+    let mb = b[..n].iter().sum::<f64>() / n as f64;
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for k in 0..n {
+        let (x, y) = (a[k] - ma, b[k] - mb);
+        sab += x * y;
+        saa += x * x;
+        sbb += y * y;
+    }
+    let r = sab / (saa * sbb).sqrt();
+    if r.is_finite() {
+        r
+    } else {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -134,26 +134,6 @@ fn free_params(t: &Term, proposed: bool, inp: &Inputs) -> Vec<String> {
         .collect()
 }
 
-/// Pearson correlation.
-fn corr(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len()) as f64;
-    if n < 3.0 {
-        return 0.0;
-    }
-    let ma = a.iter().sum::<f64>() / n;
-    let mb = b.iter().sum::<f64>() / n;
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    if saa <= 0.0 || sbb <= 0.0 {
-        return 0.0;
-    }
-    sab / (saa * sbb).sqrt()
-}
-
 /// The library effect `t` is the shape of, if any: an effect the first
 /// selection fitted but found implausible, or one the library holds for
 /// another kind of gyro, whose 1 s means follow the term's to 0.95.
@@ -162,7 +142,7 @@ fn disguise(t: &Term, d: &Discovery, implausible: &[Implausible], inp: &Inputs) 
     for i in implausible {
         let params: BTreeMap<String, f64> = i.parameters.iter().cloned().collect();
         let c = d.windows.mean(&i.effect.contribution(inp, &params));
-        if corr(&g, &c).abs() >= 0.95 {
+        if crate::numerics::stats::pearson(&g, &c).abs() >= 0.95 {
             let out: Vec<String> = i
                 .outside
                 .iter()
@@ -188,7 +168,7 @@ fn disguise(t: &Term, d: &Discovery, implausible: &[Implausible], inp: &Inputs) 
             continue;
         }
         for col in e.basis(inp, 0.0).cols {
-            if corr(&g, &d.windows.mean(&col)).abs() >= 0.95 {
+            if crate::numerics::stats::pearson(&g, &d.windows.mean(&col)).abs() >= 0.95 {
                 let kinds: Vec<&str> = [
                     crate::model::gyro_kind::GyroKind::Fog,
                     crate::model::gyro_kind::GyroKind::Rlg,
