@@ -90,7 +90,7 @@ const ADC_PER_CLOSURE: u16 = (SAMPLES_PER_HALF * 16) as u16;
 static DONE: AtomicBool = AtomicBool::new(false);
 /// Set by the closure `RLG_LEAD` closures before a frame ends: the idle loop
 /// pends the RLG update, which must deliver before the frame completes (the
-/// simulated chamber makes the task several closure periods long).
+/// simulated dithered gyro makes the task several closure periods long).
 static RLG_DUE: AtomicBool = AtomicBool::new(false);
 /// True while the RLG update task runs (the closure's latency is binned by it).
 static RLG_RUNNING: AtomicBool = AtomicBool::new(false);
@@ -100,10 +100,13 @@ static RLG_RUNNING: AtomicBool = AtomicBool::new(false);
 static SLEEPING: AtomicBool = AtomicBool::new(false);
 /// Closures run so far: the RLG bench drops a timing a closure preempted.
 static CLOSURES: AtomicU32 = AtomicU32::new(0);
-/// Closures between pending the RLG update and the frame's end.
-const RLG_LEAD: u32 = 12;
+/// Closures between pending the RLG update and the frame's end: the whole
+/// frame but one closure (the dithered gyro's simulation makes the task
+/// about 150k to 330k instructions, four closure periods, before the
+/// closures' preemption).
+const RLG_LEAD: u32 = 24;
 /// Closures before the frame's end at which the closure starts it itself.
-const RLG_LAST_START: u32 = 6;
+const RLG_LAST_START: u32 = 12;
 
 /// Simulated TMP117s on one I2C bus: they answer temperature reads with the
 /// chamber's readings; one address can be made to NACK.
