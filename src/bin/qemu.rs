@@ -55,8 +55,8 @@ use gyro_fw::overrun::{judge, DmaState};
 use gyro_fw::{stack, uart};
 use gyro_sim::rlg_dither_rig::qemu_dither_params;
 use gyro_sim::{
-    profile::qemu_demo, ChamberParams, CoilThermal, DitheredChamber, FogRig, OpticsParams,
-    Profile, ScaleFactorTruth,
+    profile::qemu_demo, ChamberParams, CoilThermal, DitheredChamber, FogRig, OpticsParams, Profile,
+    ScaleFactorTruth,
 };
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig};
@@ -305,6 +305,10 @@ pub struct ClosureBenches {
     /// or pending at entry, and those that found the idle loop busy.
     latency_under_rlg: Bench,
     latency_alone: Bench,
+    /// Frames that ended without one RLG update's words (the update late),
+    /// and the first such frame.
+    rlg_late: u32,
+    rlg_late_at: u32,
 }
 
 #[rtic::app(device = stm32f4::stm32f405, peripherals = true)]
@@ -529,10 +533,12 @@ mod app {
         );
         let (amean, amax) = latch.instructions(ipt);
         defmt::info!(
-            "bench: rlg_latch_instructions={} rlg_latch_max={} rlg_latches={}",
+            "bench: rlg_latch_instructions={} rlg_latch_max={} rlg_latches={} rlg_frames_late={} rlg_late_at={}",
             amean,
             amax,
-            latch.n
+            latch.n,
+            b.rlg_late,
+            b.rlg_late_at
         );
         let (fmean, fmax) = b.sf_frame.instructions(ipt);
         let (smean, smax) = b.sf_sensor.instructions(ipt);
@@ -641,8 +647,16 @@ mod app {
             rtic::pend(stm32f4::stm32f405::Interrupt::TIM5);
         }
         if l.out.frame_ends() {
+            let mut got = 0;
             while let Some(w) = l.rlg_words.dequeue() {
                 l.out.set_rlg(w);
+                got += 1;
+            }
+            if got != 1 {
+                if l.benches.rlg_late == 0 {
+                    l.benches.rlg_late_at = *l.counter / CLOSURES_PER_FRAME as u32;
+                }
+                l.benches.rlg_late += 1;
             }
             fog_thermal_update(
                 l.rig,
@@ -708,8 +722,7 @@ mod app {
             });
         let closures = CLOSURES.load(Ordering::Relaxed);
         let t0 = SYST::get_current();
-        r.ch
-            .update(&r.cfg, ticks(s.gyro.t_s), s.gyro.counter, temps.as_ref());
+        r.ch.update(&r.cfg, ticks(s.gyro.t_s), s.gyro.counter, temps.as_ref());
         let t1 = SYST::get_current();
         if temps.is_some() && CLOSURES.load(Ordering::Relaxed) == closures {
             r.bench.record(t0, t1);

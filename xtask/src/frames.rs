@@ -309,7 +309,12 @@ pub fn print_summary(r: &Report) {
     );
     println!(
         "{:<28} {:>6} {:>16} {:>14} {:>24} {:>16}",
-        "RLG segment", "frames", "stripped deg/s", "input deg/s", "stripped - truth deg/h", "residual counts"
+        "RLG segment",
+        "frames",
+        "stripped deg/s",
+        "input deg/s",
+        "stripped - truth deg/h",
+        "residual counts"
     );
     for s in &d.segments {
         println!(
@@ -320,7 +325,11 @@ pub fn print_summary(r: &Report) {
             s.input_dps,
             s.error_dph,
             s.residual_rms,
-            if s.constant_rate { "" } else { "  (rate not constant: the latches' interpolation)" }
+            if s.constant_rate {
+                ""
+            } else {
+                "  (rate not constant: the latches' interpolation)"
+            }
         );
     }
 }
@@ -332,9 +341,9 @@ pub fn print_summary(r: &Report) {
 pub struct DitherStats {
     /// Stripped angle (the frames' rate words, B_TC added back: the angle
     /// before the thermal compensation) minus the gyro's angle without the
-    /// dither, counts rms about its mean over the constant-rate segments
-    /// (after `DITHER_SETTLE_S`, 20 ms into each), the largest excursion;
-    /// frames in it.
+    /// dither, counts rms about each segment's mean over the constant-rate
+    /// segments (after `DITHER_SETTLE_S`, 20 ms into each), the largest
+    /// excursion; frames in it.
     pub residual_rms: f64,
     pub residual_max: f64,
     pub frames: usize,
@@ -356,7 +365,7 @@ pub struct DitherSegment {
     pub rate_dps: f64,
     pub input_dps: f64,
     pub error_dph: f64,
-    /// The residual's rms about the constant-rate segments' mean, counts.
+    /// The residual's rms about the segment's mean, counts.
     pub residual_rms: f64,
     pub constant_rate: bool,
 }
@@ -392,32 +401,37 @@ pub fn dither_stats(r: &Report) -> DitherStats {
         };
         first.get_or_insert((t, counts));
         last = Some((t, counts));
-        if std::env::var("DITHER_DEBUG").is_ok() {
-            let p = i.checked_sub(1).and_then(truth_at).unwrap_or(t);
-            eprintln!(
-                "dbg {i} strip {:.3} truth {:.3} delta {} resid {:.3}",
-                stripped(x),
-                t - p,
-                x.decoded.increments.map_or(0, |inc| inc.rlg_counts),
-                angle - t
-            );
-        }
         let rate_true = i
             .checked_sub(1)
             .and_then(truth_at)
             .map(|p| (t - p) / k / dt);
         if i as f64 * dt >= DITHER_SETTLE_S && x.t_in_segment > 0.02 {
             if let Some(rt) = rate_true {
-                used.push((x.segment, angle - t, stripped(x) / k / dt, rt, x.ref_rate / DEG));
+                used.push((
+                    x.segment,
+                    angle - t,
+                    stripped(x) / k / dt,
+                    rt,
+                    x.ref_rate / DEG,
+                ));
             }
         }
     }
+    // About each segment's own mean: a frame whose words came late (two
+    // updates' counts, one update's rate word) shifts the rate words'
+    // angle after it; the whole counts are checked over the run apart.
+    let seg_mean = |s: usize| {
+        let v: Vec<f64> = used.iter().filter(|u| u.0 == s).map(|u| u.1).collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    let means: Vec<f64> = (0..r.segment_names.len()).map(seg_mean).collect();
+    let dev = |u: &DitherFrame| u.1 - means[u.0];
     let on_constant: Vec<f64> = used
         .iter()
         .filter(|u| constant.get(u.0) == Some(&true))
-        .map(|u| u.1)
+        .map(dev)
         .collect();
-    let offset = on_constant.iter().sum::<f64>() / on_constant.len().max(1) as f64;
+    let offset = 0.0;
     let rms = |v: &mut dyn Iterator<Item = f64>| {
         let (mut sum, mut m) = (0.0, 0usize);
         for x in v {
@@ -443,7 +457,7 @@ pub fn dither_stats(r: &Report) -> DitherStats {
                 rate_dps: mean(&|u| u.2),
                 input_dps: mean(&|u| u.4),
                 error_dph: mean(&|u| u.2 - u.3) * 3600.0,
-                residual_rms: rms(&mut v.iter().map(|u| u.1)),
+                residual_rms: rms(&mut v.iter().map(|u| dev(u))),
                 constant_rate: constant.get(s) == Some(&true),
             }
         })
@@ -662,6 +676,17 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
     // dither at the frame rate, and the frames' counts are the simulated
     // gyro's (no dither, lock-in walk in it) to the floors' one count.
     let d = dither_stats(r);
+    // Every frame carries exactly one RLG update's words (the firmware
+    // counts the frames that did not: the update task was late).
+    let late = log
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix("rlg_frames_late="))
+        .and_then(|v| v.parse::<u64>().ok());
+    v.push((
+        "rlg_updates_on_time",
+        late == Some(0),
+        format!("{late:?} frames without their RLG update's words"),
+    ));
     v.push((
         "rlg_dither_stripped",
         d.residual_rms <= RESIDUAL_DITHER_MAX_COUNTS
