@@ -108,7 +108,10 @@ impl Accuracy {
         step_rad: 0.8,
         fast_trig: false,
     };
-    /// Cheaper, for the firmware under QEMU (f32 inside the windows).
+    /// Cheaper: f32 inside the windows and the polynomial sine, what a
+    /// simulation on the Cortex-M4 needs (checked against the brute force
+    /// by host-tests `rlg_dither`; the QEMU board now plays back a host
+    /// recording instead).
     pub const QEMU: Accuracy = Accuracy {
         c1: 5.0,
         c2: 30.0,

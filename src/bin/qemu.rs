@@ -15,11 +15,14 @@
 //! simulated chamber (`sim::DitheredChamber`: `sim::Chamber`, the model of
 //! `gyro-lab simulate chamber`, gives the true rate and the temperatures;
 //! `sim::DitheredRlg`, the model of `gyro-lab simulate dither`, turns it into
-//! the encoder counter and the dither pickoff's zero crossings). Each
-//! crossing goes to the channel's latch (the stripping the hw board's TIM3
-//! interrupt runs, timed by the bench), each update reads the counter and
-//! takes the stripped angle; three simulated TMP117s answer on a simulated
-//! I2C bus through the real driver. The case sensor stops
+//! the encoder counter and the dither pickoff's zero crossings). The build
+//! script records that gyro on the host (the pulse stream a board's timers
+//! would latch: simulating it on the emulated CPU cost more than the FOG's
+//! optics); the RLG task plays it back. Each crossing goes to the channel's
+//! latch (the stripping the hw board's TIM3 interrupt runs, timed by the
+//! bench), each update reads the counter and takes the stripped angle;
+//! three simulated TMP117s answer on a simulated I2C bus through the real
+//! driver. The case sensor stops
 //! answering for a while to show the fault path. Coefficients come from the
 //! build-time record (build.rs, `RLG_COEFFS`).
 //!
@@ -53,10 +56,9 @@ use gyro_fw::app::{
 };
 use gyro_fw::overrun::{judge, DmaState};
 use gyro_fw::{stack, uart};
-use gyro_sim::rlg_dither_rig::qemu_dither_params;
+use gyro_sim::rlg_dither_rig::{qemu_dither_params, LATCH_CLOCK_HZ};
 use gyro_sim::{
-    profile::qemu_demo, ChamberParams, CoilThermal, DitheredChamber, FogRig, OpticsParams, Profile,
-    ScaleFactorTruth,
+    profile::qemu_demo, ChamberParams, CoilThermal, FogRig, OpticsParams, ScaleFactorTruth,
 };
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig};
@@ -100,13 +102,10 @@ static RLG_RUNNING: AtomicBool = AtomicBool::new(false);
 static SLEEPING: AtomicBool = AtomicBool::new(false);
 /// Closures run so far: the RLG bench drops a timing a closure preempted.
 static CLOSURES: AtomicU32 = AtomicU32::new(0);
-/// Closures between pending the RLG update and the frame's end: the whole
-/// frame but one closure (the dithered gyro's simulation makes the task
-/// about 150k to 330k instructions, four closure periods, before the
-/// closures' preemption).
-const RLG_LEAD: u32 = 24;
+/// Closures between pending the RLG update and the frame's end.
+const RLG_LEAD: u32 = 12;
 /// Closures before the frame's end at which the closure starts it itself.
-const RLG_LAST_START: u32 = 12;
+const RLG_LAST_START: u32 = 6;
 
 /// Simulated TMP117s on one I2C bus: they answer temperature reads with the
 /// chamber's readings; one address can be made to NACK.
@@ -151,23 +150,34 @@ impl embedded_hal::i2c::I2c for SimI2c {
     }
 }
 
-/// The latch clock's rate (the hw board's TIM5), Hz: the simulated
-/// crossings' times are given in its ticks.
-const LATCH_CLOCK_HZ: u32 = 84_000_000;
+/// One update of the recorded dithered gyro: the encoder counter at the
+/// update's instant (latch clock ticks), the end of its crossings in
+/// `RLG_LATCHES`, and the three sensors' temperatures.
+pub struct StimulusUpdate {
+    time: u32,
+    counter: u16,
+    latches_end: u32,
+    temps_c: [f32; 3],
+}
+
+// The recorded dithered gyro (build.rs): `RLG_UPDATES`, `RLG_LATCHES`.
+include!(concat!(env!("OUT_DIR"), "/rlg_stimulus.rs"));
+// build.rs records at the firmware's update rate.
+const _: () = assert!(RLG_HZ == 500);
 
 /// The RLG update task's state: the channel, the dithered gyro in the
 /// simulated chamber on the same rate profile, and its three sensors.
 pub struct Rlg {
     cfg: RlgConfig,
     ch: RlgChannel,
-    rig: DitheredChamber<f32>,
-    profile: Profile<f32>,
     bus: SimI2c,
     sensors: [Tmp117; 3],
     updates: u32,
     bench: Bench,
     /// One pickoff crossing through the channel's latch (the stripping).
     latch: Bench,
+    /// Updates past the recorded gyro's end (its last state held).
+    held: u32,
     /// The whole task, simulated chamber included (preemptions included).
     task: Bench,
     words: Producer<'static, gyro_sp::rlg::RlgWords, { gyro_fw::app::RLG_QUEUE_LEN }>,
@@ -319,7 +329,7 @@ mod app {
     struct Shared {
         /// Filled once at the end, read by idle for the summary.
         closure_benches: Option<ClosureBenches>,
-        rlg_bench: Option<(Bench, Bench, Bench)>,
+        rlg_bench: Option<(Bench, Bench, Bench, u32)>,
     }
 
     #[local]
@@ -384,13 +394,12 @@ mod app {
         let rlg = Rlg {
             cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ).with_dither(strip),
             ch: RlgChannel::default(),
-            rig: DitheredChamber::qemu(RLG_HZ),
-            profile: profile.clone(),
             bus: SimI2c::new(),
             sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
             updates: 0,
             bench: Bench::default(),
             latch: Bench::default(),
+            held: 0,
             task: Bench::default(),
             words,
         };
@@ -512,7 +521,7 @@ mod app {
             SLEEPING.store(false, Ordering::Relaxed);
         }
         let b = cx.shared.closure_benches.lock(|b| *b).unwrap_or_default();
-        let (rlg, rlg_task, latch) = cx.shared.rlg_bench.lock(|b| *b).unwrap_or_default();
+        let (rlg, rlg_task, latch, held) = cx.shared.rlg_bench.lock(|b| *b).unwrap_or_default();
         let ipt = *cx.local.ipt;
         let (mean, max) = b.core.instructions(ipt);
         defmt::info!("frames sent: {}", sent);
@@ -533,12 +542,13 @@ mod app {
         );
         let (amean, amax) = latch.instructions(ipt);
         defmt::info!(
-            "bench: rlg_latch_instructions={} rlg_latch_max={} rlg_latches={} rlg_frames_late={} rlg_late_at={}",
+            "bench: rlg_latch_instructions={} rlg_latch_max={} rlg_latches={} rlg_frames_late={} rlg_late_at={} rlg_stimulus_held={}",
             amean,
             amax,
             latch.n,
             b.rlg_late,
-            b.rlg_late_at
+            b.rlg_late_at,
+            held
         );
         let (fmean, fmax) = b.sf_frame.instructions(ipt);
         let (smean, smax) = b.sf_sensor.instructions(ipt);
@@ -690,27 +700,32 @@ mod app {
         RLG_RUNNING.store(true, Ordering::Relaxed);
         let start = SYST::get_current();
         let r = &mut *cx.local.rlg;
-        // The crossings' and the update's instants in the latch clock's
-        // ticks (wrapping u32, as TIM5 counts on the hw board).
-        let ticks = |t_s: f64| ((t_s * LATCH_CLOCK_HZ as f64) as u64) as u32;
-        let (ch, cfg, latch_bench) = (&mut r.ch, &r.cfg, &mut r.latch);
-        let s = r.rig.step(&r.profile, |l| {
-            let sample = LatchSample {
-                time: ticks(l.t_s),
-                counter: l.counter,
-                rising: l.rising,
-                photodiodes: Some(l.photodiodes),
-            };
+        // The recorded gyro's update; past the record's end (it covers the
+        // profile and 64 updates more) the gyro's last state holds.
+        let k = (r.updates as usize).min(RLG_UPDATES.len() - 1);
+        let u = &RLG_UPDATES[k];
+        let first = k
+            .checked_sub(1)
+            .map_or(0, |p| RLG_UPDATES[p].latches_end as usize);
+        let crossings = if r.updates as usize == k {
+            RLG_LATCHES
+                .get(first..u.latches_end as usize)
+                .unwrap_or(&[])
+        } else {
+            r.held += 1;
+            &[]
+        };
+        for sample in crossings {
             let closures = CLOSURES.load(Ordering::Relaxed);
             let t0 = SYST::get_current();
-            ch.latch(cfg, &sample);
+            r.ch.latch(&r.cfg, sample);
             let t1 = SYST::get_current();
             if CLOSURES.load(Ordering::Relaxed) == closures {
-                latch_bench.record(t0, t1);
+                r.latch.record(t0, t1);
             }
-        });
-        let c = s.chamber;
-        r.bus.temps_c[..3].copy_from_slice(&[c.t_mono_a_c, c.t_mono_b_c, c.t_case_c]);
+        }
+        let [a, b, c] = u.temps_c;
+        r.bus.temps_c[..3].copy_from_slice(&[a as f64, b as f64, c as f64]);
         r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
         let temps = r
             .updates
@@ -722,7 +737,7 @@ mod app {
             });
         let closures = CLOSURES.load(Ordering::Relaxed);
         let t0 = SYST::get_current();
-        r.ch.update(&r.cfg, ticks(s.gyro.t_s), s.gyro.counter, temps.as_ref());
+        r.ch.update(&r.cfg, u.time, u.counter, temps.as_ref());
         let t1 = SYST::get_current();
         if temps.is_some() && CLOSURES.load(Ordering::Relaxed) == closures {
             r.bench.record(t0, t1);
@@ -735,7 +750,7 @@ mod app {
             r.ch.restore_frame(span);
         }
         r.task.record(start, SYST::get_current());
-        let b = (r.bench, r.task, r.latch);
+        let b = (r.bench, r.task, r.latch, r.held);
         cx.shared.rlg_bench.lock(|s| *s = Some(b));
         RLG_RUNNING.store(false, Ordering::Relaxed);
     }

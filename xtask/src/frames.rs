@@ -4,7 +4,8 @@ use anyhow::{Context, Result};
 use gyro_frames::rows::fog_rates;
 use gyro_frames::{Decoded, Decoder, RateLog, Recorder, Reference, Scales, Summary};
 use gyro_sim::profile::qemu_demo;
-use gyro_sim::{ChamberParams, DitheredChamber};
+use gyro_sim::rlg_dither_rig::qemu_stimulus;
+use gyro_sim::ChamberParams;
 use gyro_sp::fog::scale_factor::FogTempFlags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
 use gyro_sp::frame::Frame;
@@ -124,17 +125,20 @@ pub fn analyse(path: &Path) -> Result<Report> {
     })
 }
 
-/// The qemu board's dithered RLG (`sim::DitheredChamber`, the profile in
-/// f32 as the firmware has it) replayed for `updates` updates: its angle
-/// without the dither at each update's end. The run on the emulated board
-/// is a function of the same inputs (the update's index gives its instant
-/// and rate), so this is its truth, as the profile is the FOG's.
+/// The qemu board's dithered RLG replayed for `updates` updates: its angle
+/// without the dither at each update's end. The firmware plays back the
+/// record its build script made by the same call
+/// (`sim::rlg_dither_rig::qemu_stimulus`), so this is its truth, as the
+/// profile is the FOG's.
 fn replay_rlg(updates: usize) -> Vec<f64> {
-    let (profile, _) = qemu_demo::<f32>();
-    let mut rig = DitheredChamber::<f32>::qemu(RLG_HZ);
-    (0..updates)
-        .map(|_| rig.step(&profile, |_| {}).gyro.truth_counts)
-        .collect()
+    let mut truth = Vec::with_capacity(updates);
+    qemu_stimulus(
+        RLG_HZ,
+        updates as u32,
+        |s| truth.push(s.gyro.truth_counts),
+        |_| {},
+    );
+    truth
 }
 
 /// The reference of the QEMU run as a rate log: the built-in profile
@@ -677,15 +681,20 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
     // gyro's (no dither, lock-in walk in it) to the floors' one count.
     let d = dither_stats(r);
     // Every frame carries exactly one RLG update's words (the firmware
-    // counts the frames that did not: the update task was late).
-    let late = log
-        .split_whitespace()
-        .find_map(|w| w.strip_prefix("rlg_frames_late="))
-        .and_then(|v| v.parse::<u64>().ok());
+    // counts the frames that did not: the update task was late), and every
+    // update had the recorded gyro behind it (none past the record's end).
+    let word = |key: &str| {
+        log.split_whitespace()
+            .find_map(|w| w.strip_prefix(key))
+            .and_then(|v| v.parse::<u64>().ok())
+    };
+    let (late, held) = (word("rlg_frames_late="), word("rlg_stimulus_held="));
     v.push((
         "rlg_updates_on_time",
-        late == Some(0),
-        format!("{late:?} frames without their RLG update's words"),
+        late == Some(0) && held == Some(0),
+        format!(
+            "{late:?} frames without their RLG update's words, {held:?} updates past the recorded gyro"
+        ),
     ));
     v.push((
         "rlg_dither_stripped",
