@@ -16,6 +16,7 @@ fn main() {
             c1: args.get(8).copied().unwrap_or(7.0),
             c2: 50.0,
             step_rad: args.get(9).copied().unwrap_or(0.8),
+            fast_trig: false,
         },
         ..Default::default()
     };

@@ -11,6 +11,7 @@ pub mod fog_thermal;
 pub mod noise;
 pub mod profile;
 pub mod rlg_dither;
+pub mod rlg_dither_rig;
 pub mod rlg_rig;
 pub mod vibration_drift;
 
@@ -20,5 +21,6 @@ pub use fog_thermal::{CoilThermal, ScaleFactorTruth};
 pub use noise::{NoiseParams, RateNoise};
 pub use profile::{Profile, Segment};
 pub use rlg_dither::{DitherParams, DitheredRlg};
+pub use rlg_dither_rig::DitheredChamber;
 pub use rlg_rig::{Chamber, ChamberParams, ChamberSample};
 pub use vibration_drift::{eps2_point, Drift, DriftMeter, Eps2Point};

@@ -91,6 +91,13 @@ pub struct Accuracy {
     pub c2: f64,
     /// RK4 step, radians of fringe phase.
     pub step_rad: f64,
+    /// Sines and cosines outside the RK4 (window edges, the averaged
+    /// drift, the ripple, the pieces' Taylor coefficients) in the inner
+    /// loops' float by a polynomial, instead of libm's in f64: on the
+    /// Cortex-M4 libm's sin and sinf both work in soft-float f64 (2000 to
+    /// 4000 instructions a pair), which made the window search alone cost
+    /// a million instructions per half cycle.
+    pub fast_trig: bool,
 }
 
 impl Accuracy {
@@ -99,12 +106,17 @@ impl Accuracy {
         c1: 7.0,
         c2: 50.0,
         step_rad: 0.8,
+        fast_trig: false,
     };
-    /// Cheaper, for the firmware under QEMU (f32 inside the windows).
+    /// Cheaper: f32 inside the windows and the polynomial sine, what a
+    /// simulation on the Cortex-M4 needs (checked against the brute force
+    /// by host-tests `rlg_dither`; the QEMU board now plays back a host
+    /// recording instead).
     pub const QEMU: Accuracy = Accuracy {
         c1: 5.0,
         c2: 30.0,
         step_rad: 0.8,
+        fast_trig: true,
     };
 }
 
@@ -456,7 +468,13 @@ impl<F: Float> DitheredRlg<F> {
                 break;
             }
             if !self.windows.valid || self.windows.rate != rate_dps {
-                self.windows = find_windows(&hc, rate_dps, self.w_rate, self.p.lock_in_dps > 0.0);
+                self.windows = find_windows::<F>(
+                    &hc,
+                    rate_dps,
+                    self.w_rate,
+                    self.p.lock_in_dps > 0.0,
+                    self.p.accuracy.fast_trig,
+                );
             }
             // Nudged by 1e-9 of a half cycle (1e-12 s): a boundary reached
             // up to rounding counts as passed, so every segment moves on.
@@ -534,9 +552,19 @@ impl<F: Float> DitheredRlg<F> {
     /// `a w'/w^2` term from the averaged equation).
     fn ripple(&self, hc: &Half, x: f64, rate: f64) -> (f64, f64) {
         let s = (x / hc.h).clamp(0.0, 1.0);
-        let om = rate + hc.rate(s);
+        let (d_rate, d_accel) = if self.p.accuracy.fast_trig {
+            let (sn, cs) = sin_cos_in::<F>(PI * s, true);
+            let k = PI / hc.h;
+            (
+                hc.sign * k * sn * (hc.abar() - hc.d() * cs),
+                hc.sign * k * k * (cs * (hc.abar() - hc.d() * cs) + hc.d() * sn * sn),
+            )
+        } else {
+            (hc.rate(s), hc.accel(s))
+        };
+        let om = rate + d_rate;
         let r1 = self.p.lock_in_dps / om;
-        let r2 = r1 * hc.accel(s) / (2.0 * PI * self.k_fr * om * om);
+        let r2 = r1 * d_accel / (2.0 * PI * self.k_fr * om * om);
         (r1, r2)
     }
 
@@ -551,7 +579,7 @@ impl<F: Float> DitheredRlg<F> {
             return e_mean;
         }
         let v = 2.0 * PI * frac(self.fringes(hc, x, e_mean)) + self.p.beta_rad;
-        let (sv, cv) = v.sin_cos();
+        let (sv, cv) = sin_cos_in::<F>(v, self.p.accuracy.fast_trig);
         e_mean + (r1 * cv + r2 * sv) / (2.0 * PI)
     }
 
@@ -566,11 +594,12 @@ impl<F: Float> DitheredRlg<F> {
         }
         let u = 2.0 * PI * frac(self.fringes(hc, x, e)) + self.p.beta_rad;
         let mut v = u;
+        let fast = self.p.accuracy.fast_trig;
         for _ in 0..4 {
-            let (sv, cv) = v.sin_cos();
+            let (sv, cv) = sin_cos_in::<F>(v, fast);
             v = u - r1 * cv - r2 * sv;
         }
-        let (sv, cv) = v.sin_cos();
+        let (sv, cv) = sin_cos_in::<F>(v, fast);
         e - (r1 * cv + r2 * sv) / (2.0 * PI)
     }
 
@@ -585,9 +614,15 @@ impl<F: Float> DitheredRlg<F> {
         let (h, x0) = (c(hc.h), c(xa));
         let (abar, d, sign, om) = (c(hc.abar()), c(hc.d()), c(hc.sign), c(rate));
         let pi = c(PI);
+        let half_pi = c(0.5 * PI);
+        let fast = self.p.accuracy.fast_trig;
         let inv = |dx: F| {
             let s = (x0 + dx) / h;
-            let (sn, cs) = (pi * s).sin_cos();
+            let (sn, cs) = if fast {
+                (sin_small(pi * s), sin_small(pi * s + half_pi))
+            } else {
+                (pi * s).sin_cos()
+            };
             let oi = om + sign * pi / h * sn * (abar - d * cs);
             if oi.abs() > F::epsilon() {
                 F::one() / oi
@@ -631,8 +666,9 @@ impl<F: Float> DitheredRlg<F> {
         // theta_d = -sign (abar cos(pi s) - (d/4) cos(2 pi s) - d/4).
         let mut coef = [0.0f64; TAYLOR];
         let (abar, d) = (hc.abar(), hc.d());
-        let (s1, c1) = (PI * sa).sin_cos();
-        let (s2, c2) = (2.0 * PI * sa).sin_cos();
+        let fast = self.p.accuracy.fast_trig;
+        let (s1, c1) = sin_cos_in::<F>(PI * sa, fast);
+        let (s2, c2) = sin_cos_in::<F>(2.0 * PI * sa, fast);
         let mut fact = 1.0;
         let (mut p1, mut p2) = (1.0, 1.0);
         for (k, ck) in coef.iter_mut().enumerate().skip(1) {
@@ -762,7 +798,7 @@ impl Windows {
 
 /// The fine intervals of a half cycle at input rate `rate`: where
 /// `|rate + sign g(s)| < w`.
-fn find_windows(hc: &Half, rate: f64, w: f64, lock_in: bool) -> Windows {
+fn find_windows<F: Float>(hc: &Half, rate: f64, w: f64, lock_in: bool, fast: bool) -> Windows {
     let mut out = Windows {
         valid: true,
         rate,
@@ -783,6 +819,13 @@ fn find_windows(hc: &Half, rate: f64, w: f64, lock_in: bool) -> Windows {
     };
     let s_peak = c_peak.clamp(-1.0, 1.0).acos() / PI;
     let g_max = g(hc, s_peak);
+    let solve = |level: f64, a: f64, b: f64| {
+        if fast {
+            solve_fast::<F>(hc, level, a, b)
+        } else {
+            solve(hc, level, a, b)
+        }
+    };
     if hi <= 0.0 || lo >= g_max {
         return out;
     }
@@ -790,12 +833,12 @@ fn find_windows(hc: &Half, rate: f64, w: f64, lock_in: bool) -> Windows {
     let (a_hi, b_hi) = if hi >= g_max {
         (s_peak, s_peak)
     } else {
-        (solve(hc, hi, 0.0, s_peak), solve(hc, hi, s_peak, 1.0))
+        (solve(hi, 0.0, s_peak), solve(hi, s_peak, 1.0))
     };
     let (a_lo, b_lo) = if lo <= 0.0 {
         (0.0, 1.0)
     } else {
-        (solve(hc, lo, 0.0, s_peak), solve(hc, lo, s_peak, 1.0))
+        (solve(lo, 0.0, s_peak), solve(lo, s_peak, 1.0))
     };
     if a_hi > a_lo {
         out.iv[out.n] = (a_lo, a_hi);
@@ -826,6 +869,44 @@ fn solve(hc: &Half, level: f64, a: f64, b: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// The same in the inner loops' float with [`sin_small`] (`Accuracy::
+/// fast_trig`): 30 halvings reach f32's resolution (the edges then to
+/// 1e-7 of a half cycle, a tenth of a nanosecond; where a window begins
+/// matters only to where the transform holds, far inside its bounds).
+fn solve_fast<F: Float>(hc: &Half, level: f64, a: f64, b: f64) -> f64 {
+    let c = |x: f64| F::from(x).unwrap_or(F::zero());
+    let (k, abar, d, pi, half_pi) = (c(PI / hc.h), c(hc.abar()), c(hc.d()), c(PI), c(0.5 * PI));
+    let g = |s: F| {
+        let x = pi * s;
+        k * sin_small(x) * (abar - d * sin_small(x + half_pi))
+    };
+    let level = c(level);
+    let (mut lo, mut hi) = (c(a), c(b));
+    let rising = g(hi) > g(lo);
+    let half = c(0.5);
+    for _ in 0..30 {
+        let m = half * (lo + hi);
+        if (g(m) < level) == rising {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    (half * (lo + hi)).to_f64().unwrap_or(0.5 * (a + b))
+}
+
+/// sin and cos of `x` (|x| below a few pi): libm's in f64, or with
+/// `fast` ([`Accuracy::fast_trig`]) [`sin_small`] in F.
+fn sin_cos_in<F: Float>(x: f64, fast: bool) -> (f64, f64) {
+    if !fast {
+        return x.sin_cos();
+    }
+    let c = |v: f64| F::from(v).unwrap_or(F::zero());
+    let xf = c(x);
+    let to = |v: F| v.to_f64().unwrap_or(0.0);
+    (to(sin_small(xf)), to(sin_small(xf + c(0.5 * PI))))
 }
 
 /// sin for |x| below a few pi (the inner loop's reduced phase): quadrant

@@ -81,6 +81,10 @@ pub struct ChamberSample {
     /// Whole counts since power-on.
     pub counts: i64,
     pub bias_true_dph: f64,
+    /// The gyro's true rate over the step (input, bias and rate noise),
+    /// deg/s: what a gyro model with its own counter (the dithered one,
+    /// `rlg_dither_rig.rs`) integrates.
+    pub rate_true_dps: f64,
 }
 
 pub struct Chamber {
@@ -139,7 +143,8 @@ impl Chamber {
             + c.k5_dph * warm(c.tau_warm_s, t1);
         // White rate noise of rms `rate_noise_dph_1s` in 1 s: angle random walk.
         let noise_dph = p.rate_noise_dph_1s * self.normal() / dt.sqrt();
-        self.angle_deg += (rate_dps + (bias + noise_dph) / 3600.0) * dt;
+        let rate_true_dps = rate_dps + (bias + noise_dph) / 3600.0;
+        self.angle_deg += rate_true_dps * dt;
         let counts = (self.angle_deg * p.counts_per_deg).floor() as i64;
         let read = |x: f64, s: &mut Self| {
             let v = x + p.sensor_noise_c * s.normal();
@@ -154,6 +159,7 @@ impl Chamber {
             counter: counts as u16,
             counts,
             bias_true_dph: bias,
+            rate_true_dps,
         }
     }
 }

@@ -11,10 +11,18 @@
 //! pended once per frame (500 Hz) by the idle loop at a phase that sweeps the
 //! closure period, so some closures arrive while it runs: the closure's
 //! latency (SysTick wrap to its last DAC word) is measured with and without
-//! the RLG update in progress. A simulated chamber
-//! (`sim::Chamber`, the same model as `gyro-lab simulate chamber`) turns the
-//! profile's rate into encoder counts, and three simulated TMP117s answer on
-//! a simulated I2C bus through the real driver. The case sensor stops
+//! the RLG update in progress. The RLG is a mechanically dithered gyro in a
+//! simulated chamber (`sim::DitheredChamber`: `sim::Chamber`, the model of
+//! `gyro-lab simulate chamber`, gives the true rate and the temperatures;
+//! `sim::DitheredRlg`, the model of `gyro-lab simulate dither`, turns it into
+//! the encoder counter and the dither pickoff's zero crossings). The build
+//! script records that gyro on the host (the pulse stream a board's timers
+//! would latch: simulating it on the emulated CPU cost more than the FOG's
+//! optics); the RLG task plays it back. Each crossing goes to the channel's
+//! latch (the stripping the hw board's TIM3 interrupt runs, timed by the
+//! bench), each update reads the counter and takes the stripped angle;
+//! three simulated TMP117s answer on a simulated I2C bus through the real
+//! driver. The case sensor stops
 //! answering for a while to show the fault path. Coefficients come from the
 //! build-time record (build.rs, `RLG_COEFFS`).
 //!
@@ -48,15 +56,15 @@ use gyro_fw::app::{
 };
 use gyro_fw::overrun::{judge, DmaState};
 use gyro_fw::{stack, uart};
+use gyro_sim::rlg_dither_rig::{qemu_dither_params, LATCH_CLOCK_HZ};
 use gyro_sim::{
-    profile::qemu_demo, Chamber, ChamberParams, CoilThermal, FogRig, OpticsParams, Profile,
-    ScaleFactorTruth,
+    profile::qemu_demo, ChamberParams, CoilThermal, FogRig, OpticsParams, ScaleFactorTruth,
 };
 use gyro_sp::fog::scale_factor::ScaleFactorConfig;
 use gyro_sp::fog::{Faults, FogConfig};
 use gyro_sp::frame::{FrameBuilder, ResetCause};
 use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
-use gyro_sp::rlg::{RlgChannel, RlgConfig};
+use gyro_sp::rlg::{LatchSample, RlgChannel, RlgConfig, StripConfig};
 use heapless::spsc::{Consumer, Producer};
 use tmp117::Tmp117;
 
@@ -84,7 +92,7 @@ const ADC_PER_CLOSURE: u16 = (SAMPLES_PER_HALF * 16) as u16;
 static DONE: AtomicBool = AtomicBool::new(false);
 /// Set by the closure `RLG_LEAD` closures before a frame ends: the idle loop
 /// pends the RLG update, which must deliver before the frame completes (the
-/// simulated chamber makes the task several closure periods long).
+/// simulated dithered gyro makes the task several closure periods long).
 static RLG_DUE: AtomicBool = AtomicBool::new(false);
 /// True while the RLG update task runs (the closure's latency is binned by it).
 static RLG_RUNNING: AtomicBool = AtomicBool::new(false);
@@ -142,17 +150,34 @@ impl embedded_hal::i2c::I2c for SimI2c {
     }
 }
 
-/// The RLG update task's state: the channel, the simulated chamber on the
-/// same rate profile, and its three sensors.
+/// One update of the recorded dithered gyro: the encoder counter at the
+/// update's instant (latch clock ticks), the end of its crossings in
+/// `RLG_LATCHES`, and the three sensors' temperatures.
+pub struct StimulusUpdate {
+    time: u32,
+    counter: u16,
+    latches_end: u32,
+    temps_c: [f32; 3],
+}
+
+// The recorded dithered gyro (build.rs): `RLG_UPDATES`, `RLG_LATCHES`.
+include!(concat!(env!("OUT_DIR"), "/rlg_stimulus.rs"));
+// build.rs records at the firmware's update rate.
+const _: () = assert!(RLG_HZ == 500);
+
+/// The RLG update task's state: the channel, the dithered gyro in the
+/// simulated chamber on the same rate profile, and its three sensors.
 pub struct Rlg {
     cfg: RlgConfig,
     ch: RlgChannel,
-    chamber: Chamber,
-    profile: Profile<f32>,
     bus: SimI2c,
     sensors: [Tmp117; 3],
     updates: u32,
     bench: Bench,
+    /// One pickoff crossing through the channel's latch (the stripping).
+    latch: Bench,
+    /// Updates past the recorded gyro's end (its last state held).
+    held: u32,
     /// The whole task, simulated chamber included (preemptions included).
     task: Bench,
     words: Producer<'static, gyro_sp::rlg::RlgWords, { gyro_fw::app::RLG_QUEUE_LEN }>,
@@ -290,6 +315,10 @@ pub struct ClosureBenches {
     /// or pending at entry, and those that found the idle loop busy.
     latency_under_rlg: Bench,
     latency_alone: Bench,
+    /// Frames that ended without one RLG update's words (the update late),
+    /// and the first such frame.
+    rlg_late: u32,
+    rlg_late_at: u32,
 }
 
 #[rtic::app(device = stm32f4::stm32f405, peripherals = true)]
@@ -300,7 +329,7 @@ mod app {
     struct Shared {
         /// Filled once at the end, read by idle for the summary.
         closure_benches: Option<ClosureBenches>,
-        rlg_bench: Option<(Bench, Bench)>,
+        rlg_bench: Option<(Bench, Bench, Bench, u32)>,
     }
 
     #[local]
@@ -353,15 +382,24 @@ mod app {
             defmt::warn!("RLG coefficient record refused: running without thermal compensation");
         }
         let chamber_p = ChamberParams::default();
+        let gyro = qemu_dither_params(&chamber_p);
+        let drift = 1.0 + gyro.fd_drift_frac;
+        let pd = gyro.photodiodes.offset;
+        let strip = StripConfig::new(
+            LATCH_CLOCK_HZ,
+            gyro.dither_hz / drift,
+            gyro.dither_hz * drift,
+            [pd[0] as i32, pd[1] as i32],
+        );
         let rlg = Rlg {
-            cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ),
+            cfg: RlgConfig::new(thermal, chamber_p.counts_per_deg, RLG_HZ).with_dither(strip),
             ch: RlgChannel::default(),
-            chamber: Chamber::new(chamber_p, 20.0),
-            profile: profile.clone(),
             bus: SimI2c::new(),
             sensors: [Tmp117::new(0x48), Tmp117::new(0x49), Tmp117::new(0x4A)],
             updates: 0,
             bench: Bench::default(),
+            latch: Bench::default(),
+            held: 0,
             task: Bench::default(),
             words,
         };
@@ -483,7 +521,7 @@ mod app {
             SLEEPING.store(false, Ordering::Relaxed);
         }
         let b = cx.shared.closure_benches.lock(|b| *b).unwrap_or_default();
-        let (rlg, rlg_task) = cx.shared.rlg_bench.lock(|b| *b).unwrap_or_default();
+        let (rlg, rlg_task, latch, held) = cx.shared.rlg_bench.lock(|b| *b).unwrap_or_default();
         let ipt = *cx.local.ipt;
         let (mean, max) = b.core.instructions(ipt);
         defmt::info!("frames sent: {}", sent);
@@ -501,6 +539,16 @@ mod app {
             rmax,
             tmean,
             tmax
+        );
+        let (amean, amax) = latch.instructions(ipt);
+        defmt::info!(
+            "bench: rlg_latch_instructions={} rlg_latch_max={} rlg_latches={} rlg_frames_late={} rlg_late_at={} rlg_stimulus_held={}",
+            amean,
+            amax,
+            latch.n,
+            b.rlg_late,
+            b.rlg_late_at,
+            held
         );
         let (fmean, fmax) = b.sf_frame.instructions(ipt);
         let (smean, smax) = b.sf_sensor.instructions(ipt);
@@ -609,8 +657,16 @@ mod app {
             rtic::pend(stm32f4::stm32f405::Interrupt::TIM5);
         }
         if l.out.frame_ends() {
+            let mut got = 0;
             while let Some(w) = l.rlg_words.dequeue() {
                 l.out.set_rlg(w);
+                got += 1;
+            }
+            if got != 1 {
+                if l.benches.rlg_late == 0 {
+                    l.benches.rlg_late_at = *l.counter / CLOSURES_PER_FRAME as u32;
+                }
+                l.benches.rlg_late += 1;
             }
             fog_thermal_update(
                 l.rig,
@@ -632,20 +688,44 @@ mod app {
     }
 
     /// One RLG update (lower priority, preempted by the closure): the
-    /// chamber advances one update period and the counter is read; on sensor
-    /// ticks the three TMP117s are read and the compensation runs (the bench
-    /// times counter read + compensation, the hw task's work). The frame
-    /// words go to the closure through a lock-free queue.
+    /// dithered gyro advances one update period, each pickoff crossing on
+    /// the way goes to the channel's latch (as the hw board's TIM3
+    /// interrupt does; the bench times each), then the counter is read; on
+    /// sensor ticks the three TMP117s are read and the compensation runs
+    /// (the bench times counter read + stripped angle + compensation, the
+    /// hw update task's work). The frame words go to the closure through a
+    /// lock-free queue.
     #[task(binds = TIM5, priority = 1, local = [rlg], shared = [rlg_bench])]
     fn rlg_update(mut cx: rlg_update::Context) {
         RLG_RUNNING.store(true, Ordering::Relaxed);
         let start = SYST::get_current();
         let r = &mut *cx.local.rlg;
-        let dt = 1.0 / RLG_HZ as f64;
-        let t_mid = (r.updates as f64 + 0.5) * dt;
-        let rate_dps = r.profile.rate_at(t_mid as f32) as f64 * (180.0 / core::f64::consts::PI);
-        let s = r.chamber.step(dt, 20.0, rate_dps);
-        r.bus.temps_c[..3].copy_from_slice(&[s.t_mono_a_c, s.t_mono_b_c, s.t_case_c]);
+        // The recorded gyro's update; past the record's end (it covers the
+        // profile and 64 updates more) the gyro's last state holds.
+        let k = (r.updates as usize).min(RLG_UPDATES.len() - 1);
+        let u = &RLG_UPDATES[k];
+        let first = k
+            .checked_sub(1)
+            .map_or(0, |p| RLG_UPDATES[p].latches_end as usize);
+        let crossings = if r.updates as usize == k {
+            RLG_LATCHES
+                .get(first..u.latches_end as usize)
+                .unwrap_or(&[])
+        } else {
+            r.held += 1;
+            &[]
+        };
+        for sample in crossings {
+            let closures = CLOSURES.load(Ordering::Relaxed);
+            let t0 = SYST::get_current();
+            r.ch.latch(&r.cfg, sample);
+            let t1 = SYST::get_current();
+            if CLOSURES.load(Ordering::Relaxed) == closures {
+                r.latch.record(t0, t1);
+            }
+        }
+        let [a, b, c] = u.temps_c;
+        r.bus.temps_c[..3].copy_from_slice(&[a as f64, b as f64, c as f64]);
         r.bus.nack = CASE_NACK.contains(&r.updates).then_some(0x4A);
         let temps = r
             .updates
@@ -657,8 +737,7 @@ mod app {
             });
         let closures = CLOSURES.load(Ordering::Relaxed);
         let t0 = SYST::get_current();
-        // Undithered: the update's time only matters to the stripping.
-        r.ch.update(&r.cfg, r.updates, s.counter, temps.as_ref());
+        r.ch.update(&r.cfg, u.time, u.counter, temps.as_ref());
         let t1 = SYST::get_current();
         if temps.is_some() && CLOSURES.load(Ordering::Relaxed) == closures {
             r.bench.record(t0, t1);
@@ -671,7 +750,7 @@ mod app {
             r.ch.restore_frame(span);
         }
         r.task.record(start, SYST::get_current());
-        let b = (r.bench, r.task);
+        let b = (r.bench, r.task, r.latch, r.held);
         cx.shared.rlg_bench.lock(|s| *s = Some(b));
         RLG_RUNNING.store(false, Ordering::Relaxed);
     }

@@ -4,6 +4,7 @@ use anyhow::{Context, Result};
 use gyro_frames::rows::fog_rates;
 use gyro_frames::{Decoded, Decoder, RateLog, Recorder, Reference, Scales, Summary};
 use gyro_sim::profile::qemu_demo;
+use gyro_sim::rlg_dither_rig::qemu_stimulus;
 use gyro_sim::ChamberParams;
 use gyro_sp::fog::scale_factor::FogTempFlags;
 use gyro_sp::fog::{Faults, FogConfig, FogParams};
@@ -14,6 +15,15 @@ use std::path::Path;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 const DPH: f64 = 3600.0 / DEG;
+/// The qemu board's RLG update rate, one per frame (src/app.rs `RLG_HZ`).
+const RLG_HZ: u32 = 500;
+/// Time left out of the dither statistics while the stripping learns its
+/// corrections (the quadrant offset in 64 latches, 80 ms; the alternation
+/// averages 256, a time constant of 0.32 s), s.
+const DITHER_SETTLE_S: f64 = 0.5;
+/// The residual dither the stripping may leave, counts rms at the frame
+/// rate (issue 33's acceptance).
+pub const RESIDUAL_DITHER_MAX_COUNTS: f64 = 0.5;
 
 pub struct Row {
     pub t_s: f64,
@@ -37,6 +47,10 @@ pub struct Report {
     pub segment_names: [&'static str; 8],
     pub cfg: FogConfig,
     pub summary: Summary,
+    /// The simulated RLG's angle without the dither (counts, continuous;
+    /// lock-in error, bias and rate noise in it) at the end of each RLG
+    /// update (`k` at `(k + 1) / RLG_HZ`), replayed on the host.
+    pub rlg_truth: Vec<f64>,
 }
 
 /// Decodes frames through the one decoder (`gyro-frames`, as `gyro-lab
@@ -98,7 +112,9 @@ pub fn analyse(path: &Path) -> Result<Report> {
         });
     }
     summary.finish(&dec);
+    let rlg_truth = replay_rlg(rows.len() + 1);
     Ok(Report {
+        rlg_truth,
         rows,
         bad_frames: dec.crc_errors as usize,
         seq_gaps: dec.lost_frames as usize,
@@ -107,6 +123,22 @@ pub fn analyse(path: &Path) -> Result<Report> {
         cfg,
         summary,
     })
+}
+
+/// The qemu board's dithered RLG replayed for `updates` updates: its angle
+/// without the dither at each update's end. The firmware plays back the
+/// record its build script made by the same call
+/// (`sim::rlg_dither_rig::qemu_stimulus`), so this is its truth, as the
+/// profile is the FOG's.
+fn replay_rlg(updates: usize) -> Vec<f64> {
+    let mut truth = Vec::with_capacity(updates);
+    qemu_stimulus(
+        RLG_HZ,
+        updates as u32,
+        |s| truth.push(s.gyro.truth_counts),
+        |_| {},
+    );
+    truth
 }
 
 /// The reference of the QEMU run as a rate log: the built-in profile
@@ -272,6 +304,177 @@ pub fn print_summary(r: &Report) {
          temperatures {:.3}/{:.3}/{:.3} degC (mono A/B, case); flags seen {:#04x}",
         g.angle_deg, g.counts, g.truth_deg, g.error_counts, g.bias_dph, g.temps[0], g.temps[1], g.temps[2], g.flags_seen
     );
+    let d = dither_stats(r);
+    println!(
+        "RLG dither (400 Hz, 150 deg/s, stripped at the pickoff's zero crossings): residual {:.3} counts rms \
+         (max {:.3}) at the frame rate over the constant-rate segments ({} frames from {} s); frames' counts {} \
+         against the simulated gyro's {:.2} ({:+.2} counts)",
+        d.residual_rms, d.residual_max, d.frames, DITHER_SETTLE_S, d.counts, d.truth_counts, d.error_counts
+    );
+    println!(
+        "{:<28} {:>6} {:>16} {:>14} {:>24} {:>16}",
+        "RLG segment",
+        "frames",
+        "stripped deg/s",
+        "input deg/s",
+        "stripped - truth deg/h",
+        "residual counts"
+    );
+    for s in &d.segments {
+        println!(
+            "{:<28} {:>6} {:>16.6} {:>14.6} {:>24.3} {:>16.3}{}",
+            s.name,
+            s.frames,
+            s.rate_dps,
+            s.input_dps,
+            s.error_dph,
+            s.residual_rms,
+            if s.constant_rate {
+                ""
+            } else {
+                "  (rate not constant: the latches' interpolation)"
+            }
+        );
+    }
+}
+
+/// The dithered RLG's frames against the simulated gyro: the frame for
+/// RLG update k carries the stripped angle at update k - 1's instant
+/// (`k / RLG_HZ`; the stripping waits for the latch after it), so frame
+/// row i (update i) stands for the truth at the end of update i - 1.
+pub struct DitherStats {
+    /// Stripped angle (the frames' rate words, B_TC added back: the angle
+    /// before the thermal compensation) minus the gyro's angle without the
+    /// dither, counts rms about each segment's mean over the constant-rate
+    /// segments (after `DITHER_SETTLE_S`, 20 ms into each), the largest
+    /// excursion; frames in it.
+    pub residual_rms: f64,
+    pub residual_max: f64,
+    pub frames: usize,
+    /// The frames' whole counts minus the truth's count integral from the
+    /// first frame to the last (the floors make it at most one count).
+    pub error_counts: f64,
+    pub counts: i64,
+    pub truth_counts: f64,
+    pub segments: Vec<DitherSegment>,
+}
+
+/// One segment of the profile (after 20 ms and `DITHER_SETTLE_S`).
+pub struct DitherSegment {
+    pub name: &'static str,
+    pub frames: usize,
+    /// The stripped rate's mean and the input rate's, deg/s; the stripped
+    /// rate's mean error against the gyro's rate without the dither (bias,
+    /// rate noise and lock-in walk in it), deg/h.
+    pub rate_dps: f64,
+    pub input_dps: f64,
+    pub error_dph: f64,
+    /// The residual's rms about the segment's mean, counts.
+    pub residual_rms: f64,
+    pub constant_rate: bool,
+}
+
+/// (segment, residual counts, stripped rate, true rate, input rate; deg/s).
+type DitherFrame = (usize, f64, f64, f64, f64);
+
+pub fn dither_stats(r: &Report) -> DitherStats {
+    let k = ChamberParams::default().counts_per_deg;
+    let dt = 1.0 / RLG_HZ as f64;
+    let (profile, _) = qemu_demo::<f64>();
+    let constant: Vec<bool> = profile
+        .segments
+        .iter()
+        .map(|s| matches!(s, gyro_sim::Segment::Constant { .. }))
+        .collect();
+    // Row i's truth: the end of update i - 1 (row 0's instant is 0).
+    let truth_at = |i: usize| i.checked_sub(1).and_then(|j| r.rlg_truth.get(j).copied());
+    // The stripped angle over each frame, counts (the compensated rate
+    // with B_TC added back, over one update).
+    let stripped = |x: &Row| {
+        let w = x.frame.rlg;
+        (w.rate_comp_udps as f64 * 1e-6 + w.bias_q16_dph as f64 / 65_536.0 / 3600.0) * dt * k
+    };
+    let (mut angle, mut counts) = (0.0, 0i64);
+    let (mut first, mut last) = (None::<(f64, i64)>, None::<(f64, i64)>);
+    let mut used: Vec<DitherFrame> = vec![];
+    for (i, x) in r.rows.iter().enumerate() {
+        angle += stripped(x);
+        counts += x.decoded.increments.map_or(0, |inc| inc.rlg_counts);
+        let Some(t) = truth_at(i) else {
+            continue;
+        };
+        first.get_or_insert((t, counts));
+        last = Some((t, counts));
+        let rate_true = i
+            .checked_sub(1)
+            .and_then(truth_at)
+            .map(|p| (t - p) / k / dt);
+        if i as f64 * dt >= DITHER_SETTLE_S && x.t_in_segment > 0.02 {
+            if let Some(rt) = rate_true {
+                used.push((
+                    x.segment,
+                    angle - t,
+                    stripped(x) / k / dt,
+                    rt,
+                    x.ref_rate / DEG,
+                ));
+            }
+        }
+    }
+    // About each segment's own mean: a frame whose words came late (two
+    // updates' counts, one update's rate word) shifts the rate words'
+    // angle after it; the whole counts are checked over the run apart.
+    let seg_mean = |s: usize| {
+        let v: Vec<f64> = used.iter().filter(|u| u.0 == s).map(|u| u.1).collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    let means: Vec<f64> = (0..r.segment_names.len()).map(seg_mean).collect();
+    let dev = |u: &DitherFrame| u.1 - means[u.0];
+    let on_constant: Vec<f64> = used
+        .iter()
+        .filter(|u| constant.get(u.0) == Some(&true))
+        .map(dev)
+        .collect();
+    let offset = 0.0;
+    let rms = |v: &mut dyn Iterator<Item = f64>| {
+        let (mut sum, mut m) = (0.0, 0usize);
+        for x in v {
+            sum += (x - offset).powi(2);
+            m += 1;
+        }
+        (sum / m.max(1) as f64).sqrt()
+    };
+    let residual_rms = rms(&mut on_constant.iter().copied());
+    let residual_max = on_constant
+        .iter()
+        .map(|v| (v - offset).abs())
+        .fold(0.0, f64::max);
+    let ((t0, c0), (t1, c1)) = (first.unwrap_or_default(), last.unwrap_or_default());
+    let segments = (0..r.segment_names.len())
+        .map(|s| {
+            let v: Vec<&DitherFrame> = used.iter().filter(|u| u.0 == s).collect();
+            let m = v.len().max(1) as f64;
+            let mean = |f: &dyn Fn(&DitherFrame) -> f64| v.iter().map(|u| f(u)).sum::<f64>() / m;
+            DitherSegment {
+                name: r.segment_names[s],
+                frames: v.len(),
+                rate_dps: mean(&|u| u.2),
+                input_dps: mean(&|u| u.4),
+                error_dph: mean(&|u| u.2 - u.3) * 3600.0,
+                residual_rms: rms(&mut v.iter().map(|u| dev(u))),
+                constant_rate: constant.get(s) == Some(&true),
+            }
+        })
+        .collect();
+    DitherStats {
+        residual_rms,
+        residual_max,
+        frames: on_constant.len(),
+        error_counts: (c1 - c0) as f64 - (t1 - t0),
+        counts: c1 - c0,
+        truth_counts: t1 - t0,
+        segments,
+    }
 }
 
 pub struct FogTempStats {
@@ -471,6 +674,37 @@ pub fn qemu_checks(r: &Report, log: &str) -> Vec<(&'static str, bool, String)> {
         format!(
             "{} counts, {:+.2} counts from the truth",
             g.counts, g.error_counts
+        ),
+    ));
+    // The dithered gyro: the stripping leaves at most 0.5 count rms of
+    // dither at the frame rate, and the frames' counts are the simulated
+    // gyro's (no dither, lock-in walk in it) to the floors' one count.
+    let d = dither_stats(r);
+    // Every frame carries exactly one RLG update's words (the firmware
+    // counts the frames that did not: the update task was late), and every
+    // update had the recorded gyro behind it (none past the record's end).
+    let word = |key: &str| {
+        log.split_whitespace()
+            .find_map(|w| w.strip_prefix(key))
+            .and_then(|v| v.parse::<u64>().ok())
+    };
+    let (late, held) = (word("rlg_frames_late="), word("rlg_stimulus_held="));
+    v.push((
+        "rlg_updates_on_time",
+        late == Some(0) && held == Some(0),
+        format!(
+            "{late:?} frames without their RLG update's words, {held:?} updates past the recorded gyro"
+        ),
+    ));
+    v.push((
+        "rlg_dither_stripped",
+        d.residual_rms <= RESIDUAL_DITHER_MAX_COUNTS
+            && d.frames > 0
+            && d.error_counts.abs() < 1.0 + 2.0 * d.residual_max
+            && g.flags_seen & (RlgFlags::NO_PICKOFF | RlgFlags::LATCH_REFUSED).bits() == 0,
+        format!(
+            "residual {:.3} counts rms (max {:.3}); {:+.2} counts from the simulated gyro; flags seen {:#04x}",
+            d.residual_rms, d.residual_max, d.error_counts, g.flags_seen
         ),
     ));
     v.push((
