@@ -62,6 +62,18 @@ pub const SMOOTH_S: f64 = 60.0;
 /// Most passes of the selection.
 pub const MAX_PASSES: usize = 4;
 
+/// An effect whose addition to the model varies by less than this share
+/// of the noise floor (RMS of its 1 s means about their mean), and
+/// nowhere by more than [`IMMATERIAL_PEAK_OF_FLOOR`] of it, is carried but
+/// not named: a long record makes it significant, but it changes no
+/// prediction the run can check (the gap by under half a percent), and
+/// what it follows is as likely a sensor's lag or another effect's
+/// remainder as a physical effect of its own.
+pub const IMMATERIAL_OF_FLOOR: f64 = 0.1;
+/// ... and its largest 1 s mean about the mean (an effect seen in one
+/// stretch only, lock-in near zero rate, stays named).
+pub const IMMATERIAL_PEAK_OF_FLOOR: f64 = 0.25;
+
 /// The least rate, deg/s, a run must reach beyond the Earth rate (0.004
 /// deg/s) for lock-in to show: a lock-in rate below it is not an RLG's.
 pub const LOCK_IN_MIN_DPS: f64 = 0.01;
@@ -319,6 +331,20 @@ fn model_effect(e: &Estimate) -> ModelEffect {
     }
 }
 
+/// RMS and largest magnitude of what `e` adds to `model` on `run`, its 1 s
+/// means about their mean (a constant offset is the bias's), deg/h.
+fn varying_dph(model: &Model, run: &Run, win: &Windows, e: &Estimate) -> (f64, f64) {
+    let base = residual(model, run);
+    let added = residual(&with(model, &[e]), run);
+    let diff: Vec<f64> = base.iter().zip(&added).map(|(a, b)| a - b).collect();
+    let m = win.mean(&diff);
+    let n = m.len().max(1) as f64;
+    let mean = m.iter().sum::<f64>() / n;
+    let rms = (m.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt();
+    let peak = m.iter().map(|v| (v - mean).abs()).fold(0.0, f64::max);
+    (rms * 3600.0, peak * 3600.0)
+}
+
 /// `model` with `add` appended.
 fn with(model: &Model, add: &[&Estimate]) -> Model {
     let mut m = model.clone();
@@ -567,6 +593,15 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
             } else {
                 format!("not named: {NOT_SIGNIFICANT}")
             }),
+            None if e.effect != Effect::Bias => {
+                let (size, peak) = varying_dph(model, run, &win, &e);
+                (size < IMMATERIAL_OF_FLOOR * floor && peak < IMMATERIAL_PEAK_OF_FLOOR * floor)
+                    .then(|| {
+                    format!(
+                        "not named: what it adds to the model varies by {size:.4} deg/h RMS (at most {peak:.4}), under {IMMATERIAL_OF_FLOOR} ({IMMATERIAL_PEAK_OF_FLOOR}) of the noise floor ({floor:.4} deg/h): significant over this record, but too small to change what the run can check"
+                    )
+                })
+            }
             w => w,
         };
         match why {
