@@ -363,12 +363,27 @@ pub fn beyond(
                 ),
             }
         };
+        // A proposed term whose shape was fitted in two parameters (the
+        // settling) has its coefficients' intervals from a fit that frees
+        // them too: the shape held would leave out what the onset and the
+        // time constant leave uncertain.
+        let shape_free = t.params.len() - free.len();
+        let joint = (is_proposed && shape_free >= 2)
+            .then(|| {
+                let all: Vec<String> = t.params.keys().cloned().collect();
+                refit(given, &cur, run, i, &all)
+            })
+            .flatten();
         if let Some(f) = &fitted {
             // The coefficients' intervals beside the effects named with
             // the term (the value is the one the model carries).
             for p in &free {
                 if let (Some(iv), Some(v)) = (f.intervals.get(p), t.params.get(p)) {
-                    let half = 0.5 * (iv.1 - iv.0);
+                    let wide = joint
+                        .as_ref()
+                        .and_then(|j| j.intervals.get(p))
+                        .map_or(0.0, |j| 0.5 * (j.1 - j.0));
+                    let half = (0.5 * (iv.1 - iv.0)).max(if wide.is_finite() { wide } else { 0.0 });
                     intervals.insert(p.clone(), (v - half, v + half));
                 }
             }

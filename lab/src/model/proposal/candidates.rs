@@ -3,12 +3,17 @@
 //! the term proposed is evaluated exactly as it was validated.
 //!
 //! Small on purpose. Every candidate has one or two linear coefficients
-//! and at most one searched shape parameter: a term cannot fit noise by
-//! being flexible, and the validation's threshold (validation.rs) pays for
-//! the whole space at once. Physical terms come first (products and powers
-//! of the rate, |rate|, the temperatures, their filtered derivatives, the
+//! and at most one searched shape parameter, but one: the settling from a
+//! time searches its onset and its time constant, on coarse grids (the
+//! onsets the step and the ramp share, ten time constants), and counts as
+//! more complex than any one-parameter shape, so it is proposed only
+//! where it predicts clearly better. A term cannot fit noise by being
+//! flexible, and the validation's threshold (validation.rs) pays for the
+//! whole space at once. Physical terms come first (products and powers of
+//! the rate, |rate|, the temperatures, their filtered derivatives, the
 //! acceleration), then the one-off shapes (a step at a time, a sinusoid at
-//! a period, an exponential with a time constant, a ramp).
+//! a period, an exponential with a time constant, a ramp, a settling from
+//! a time).
 
 use crate::data::run_file::Column;
 use crate::model::inputs::Inputs;
@@ -28,13 +33,14 @@ pub struct Searched {
     pub grid: Vec<f64>,
 }
 
-/// A candidate term: its parts (summed) and the parameter searched, if any.
+/// A candidate term: its parts (summed) and the parameters searched (none,
+/// one, or the settling's two, searched on every pair of their grids).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
     /// What a gyro engineer would call it.
     pub label: &'static str,
     pub parts: Vec<Part>,
-    pub searched: Option<Searched>,
+    pub searched: Vec<Searched>,
 }
 
 impl Candidate {
@@ -48,10 +54,26 @@ impl Candidate {
         p.join(" + ")
     }
 
-    /// Linear coefficients plus the searched parameter: what the term can
+    /// Linear coefficients plus the searched parameters: what the term can
     /// bend (the simplest explanation has the fewest).
     pub fn freedom(&self) -> usize {
-        self.parts.len() + usize::from(self.searched.is_some())
+        self.parts.len() + self.searched.len()
+    }
+
+    /// Every point of the search: one value per searched parameter, in
+    /// their order (one empty point when nothing is searched).
+    pub fn points(&self) -> Vec<Vec<f64>> {
+        self.searched.iter().fold(vec![vec![]], |pts, s| {
+            pts.iter()
+                .flat_map(|p| {
+                    s.grid.iter().map(move |&v| {
+                        let mut q = p.clone();
+                        q.push(v);
+                        q
+                    })
+                })
+                .collect()
+        })
     }
 }
 
@@ -62,7 +84,7 @@ fn one(label: &'static str, shape: String) -> Candidate {
             coef: "k_dph",
             shape,
         }],
-        searched: None,
+        searched: vec![],
     }
 }
 
@@ -74,6 +96,15 @@ fn moves(x: &[f64]) -> bool {
     });
     hi - lo > 1e-9 * hi.abs().max(lo.abs()).max(1.0) && x.len() > 2
 }
+
+/// Time constants the settling from a time is searched over, from
+/// [`SETTLING_TAU_MIN_S`] to a third of the record.
+pub const SETTLING_TAUS: usize = 10;
+
+/// The settling's shortest time constant searched, s (a faster settling
+/// is a step at the 1 s means' resolution, and the refinement may still
+/// shorten it).
+pub const SETTLING_TAU_MIN_S: f64 = 120.0;
 
 /// `n` values from `a` to `b`, evenly spaced in log.
 fn log_grid(a: f64, b: f64, n: usize) -> Vec<f64> {
@@ -161,10 +192,10 @@ pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
                     coef: "k_dph",
                     shape,
                 }],
-                searched: Some(Searched {
+                searched: vec![Searched {
                     name: "t0_s",
                     grid: onsets.clone(),
-                }),
+                }],
             });
         }
         // Sinusoids: two or more periods in the record, down to 5 min.
@@ -181,10 +212,10 @@ pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
                         shape: format!("cos(2 * pi * {t} / p_s)"),
                     },
                 ],
-                searched: Some(Searched {
+                searched: vec![Searched {
                     name: "p_s",
                     grid: log_grid(300.0, span / 2.0, 80),
-                }),
+                }],
             });
         }
         c.push(Candidate {
@@ -193,11 +224,39 @@ pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
                 coef: "k_dph",
                 shape: format!("exp(-{t} / tau_s)"),
             }],
-            searched: Some(Searched {
+            searched: vec![Searched {
                 name: "tau_s",
                 grid: log_grid(60.0, span, 40),
-            }),
+            }],
         });
+        // A settling from a time (a bias that settles after an event: a
+        // mode hop, a relock, a heater switched), first order: 0 before
+        // t1, k (1 - exp(-(t - t1) / tau)) after. The step and the ramp
+        // from a time are its limits (tau -> 0, tau -> infinity). The
+        // step inside the exponential keeps its argument at or below zero
+        // (no overflow before t1). Onsets on the steps' grid, time
+        // constants from 2 min to a third of the record: 96 x 10 points,
+        // each judged as every candidate is (refined afterwards, both
+        // parameters jointly, by refit.rs).
+        if span / 3.0 > 2.0 * SETTLING_TAU_MIN_S {
+            c.push(Candidate {
+                label: "settling from a time",
+                parts: vec![Part {
+                    coef: "k_dph",
+                    shape: format!("(1 - exp(-({t} - t1_s) * step({t} - t1_s) / tau_s))"),
+                }],
+                searched: vec![
+                    Searched {
+                        name: "t1_s",
+                        grid: onsets.clone(),
+                    },
+                    Searched {
+                        name: "tau_s",
+                        grid: log_grid(SETTLING_TAU_MIN_S, span / 3.0, SETTLING_TAUS),
+                    },
+                ],
+            });
+        }
     }
     c
 }

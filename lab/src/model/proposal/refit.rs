@@ -9,8 +9,8 @@
 //! formula uses non-linearly converges and a linear one is exact in one
 //! step.
 
-use super::validation::{cross_validate, solve, stats, FOLDS, THRESHOLD};
-use super::{basis, dot, Validation};
+use super::orthogonal::{basis, dot, orthogonal};
+use super::validation::{cross_validate, solve, stats, Validation, FOLDS, THRESHOLD};
 use crate::model::inputs::Inputs;
 use crate::model::term::Term;
 use std::collections::BTreeMap;
@@ -91,15 +91,6 @@ fn solve_held(a: &[f64], c: &[f64]) -> Option<Vec<f64>> {
         }
     }
     solve(&a, &c)
-}
-
-/// `x` less its projection on the orthonormal `q`.
-fn orthogonal(mut x: Vec<f64>, q: &[Vec<f64>]) -> Vec<f64> {
-    for u in q {
-        let d = dot(u, &x);
-        x.iter_mut().zip(u).for_each(|(a, b)| *a -= d * b);
-    }
-    x
 }
 
 /// Fits the parameters `free` of `t` (the others held) to `y`: the
