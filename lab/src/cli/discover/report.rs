@@ -346,6 +346,11 @@ fn effect_plots(r: &mut Report, d: &Discovery, run: &Run) {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
                 (a.min(*x), b.max(*x))
             });
+        // A constant (the bias) has no shape to plot against the residual:
+        // its points would stand in one column.
+        if hi - lo <= 1e-9 * lo.abs().max(hi.abs()) {
+            continue;
+        }
         r.plot(
             &Axes {
                 title: format!("{}: regressor against residual", e.effect.name()),
@@ -461,7 +466,7 @@ fn verdict(d: &Discovery) -> Verdict {
             "a term outside the physics library is in the model written: it predicts the data, but it is not a named physical effect",
         );
     }
-    v.text("The gap (RMS of 1 s means of measured - model) went from ")
+    v.text(" The gap (RMS of 1 s means of measured - model) went from ")
         .num("gap_before_dph", d.gap_before_dph, 4)
         .text(" to ")
         .num("gap_after_dph", d.gap_after_dph, 4)
