@@ -331,10 +331,10 @@ fn model_effect(e: &Estimate) -> ModelEffect {
     }
 }
 
-/// RMS and largest magnitude of what `e` adds to `model` on `run`, its 1 s
-/// means about their mean (a constant offset is the bias's), deg/h.
-fn varying_dph(model: &Model, run: &Run, win: &Windows, e: &Estimate) -> (f64, f64) {
-    let base = residual(model, run);
+/// RMS and largest magnitude of what `e` adds to `model` on `run` (whose
+/// residual is `base`), its 1 s means about their mean (a constant offset
+/// is the bias's), deg/h.
+fn varying_dph(model: &Model, run: &Run, base: &[f64], win: &Windows, e: &Estimate) -> (f64, f64) {
     let added = residual(&with(model, &[e]), run);
     let diff: Vec<f64> = base.iter().zip(&added).map(|(a, b)| a - b).collect();
     let m = win.mean(&diff);
@@ -594,7 +594,7 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
                 format!("not named: {NOT_SIGNIFICANT}")
             }),
             None if e.effect != Effect::Bias => {
-                let (size, peak) = varying_dph(model, run, &win, &e);
+                let (size, peak) = varying_dph(model, run, &r, &win, &e);
                 (size < IMMATERIAL_OF_FLOOR * floor && peak < IMMATERIAL_PEAK_OF_FLOOR * floor)
                     .then(|| {
                     format!(
