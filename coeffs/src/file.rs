@@ -12,8 +12,14 @@
 //! sf_ppm = [60.0, 192.0, 282.0]
 //! bias_dph = [0.1, 0.2, 0.21]
 //! sensor_lag_s = 30.0
+//! [range]                       # the temperatures the set was fitted over, degC
+//! temp_c = [-40.2, 50.1]
 //! [fit]                         # optional, informative: where the set came from
 //! ```
+//!
+//! A set whose `[range]` leaves the sensors' -55..+150 degC (a fit on
+//! kelvin read as degC) is refused here, so neither the lab nor the
+//! build takes it.
 
 use crate::{ScaleFactorTable, ThermalCoeffs};
 use serde::{Deserialize, Serialize};
@@ -52,10 +58,23 @@ impl ScaleFactorFile {
     }
 }
 
+/// The temperatures a set was fitted over, degC (every sensor it reads).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FittedRange {
+    pub temp_c: [f64; 2],
+}
+
+/// The range the firmware's temperature sensors read, degC
+/// (dsp/src/sensor.rs refuses a reading outside it).
+pub const SENSOR_RANGE_C: (f64, f64) = (-55.0, 150.0);
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CoeffFile {
     pub kind: String,
     pub version: u16,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range: Option<FittedRange>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rlg_thermal: Option<ThermalCoeffs>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -79,6 +98,7 @@ impl CoeffFile {
         Self {
             kind: "rlg_thermal".into(),
             version: VERSION,
+            range: None,
             rlg_thermal: Some(c),
             fog_scale_factor: None,
             fit: Some(fit),
@@ -89,6 +109,7 @@ impl CoeffFile {
         Self {
             kind: "fog_scale_factor".into(),
             version: VERSION,
+            range: None,
             rlg_thermal: None,
             fog_scale_factor: Some(ScaleFactorFile::from_table(t)),
             fit: Some(fit),
@@ -119,6 +140,23 @@ pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
             "{name}: version {} (this tool reads version {VERSION})",
             f.version
         ));
+    }
+    if let Some(r) = &f.range {
+        let [lo, hi] = r.temp_c;
+        let (min, max) = SENSOR_RANGE_C;
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+            return Err(format!(
+                "{name}: [range] temp_c = [{lo}, {hi}] is not a range"
+            ));
+        }
+        if lo < min || hi > max {
+            let kelvin = (lo - 273.15 >= min && hi - 273.15 <= max)
+                .then(|| format!(" ({:.1}..{:.1} degC if the fit read kelvin as degC: refit with --temp-unit K)", lo - 273.15, hi - 273.15))
+                .unwrap_or_default();
+            return Err(format!(
+                "{name}: fitted over {lo:.1}..{hi:.1} degC ([range] temp_c), outside the {min}..+{max} degC the firmware's sensors read{kelvin}"
+            ));
+        }
     }
     let c = match (f.kind.as_str(), &f.rlg_thermal, &f.fog_scale_factor) {
         ("rlg_thermal", Some(c), None) => {
@@ -162,9 +200,26 @@ pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
     Ok((f, c))
 }
 
-/// Writes a coefficient file with a comment header.
+/// Writes a coefficient file with a comment header, atomically (a
+/// temporary file beside it, renamed into place once complete: a crash
+/// leaves the old file whole).
 pub fn write(path: &Path, f: &CoeffFile, comment: &str) -> Result<(), String> {
+    use std::io::Write;
     let body = toml::to_string(f).map_err(|e| e.to_string())?;
     let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
-    std::fs::write(path, format!("{head}{body}")).map_err(|e| format!("{}: {e}", path.display()))
+    let err = |e: std::io::Error| format!("{}: {e}", path.display());
+    let name = path
+        .file_name()
+        .map_or_else(|| "coeffs".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    let written = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(format!("{head}{body}").as_bytes())?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(err)
 }

@@ -99,11 +99,10 @@ impl LabError {
         }
     }
 
+    /// 2 for every error: bad input, and an output that cannot be written
+    /// (a user's path too) alike.
     pub fn exit_code(&self) -> u8 {
-        match self {
-            LabError::Usage(_) | LabError::Input { .. } | LabError::Bench(_) => 2,
-            LabError::Io { .. } => 1,
-        }
+        2
     }
 }
 
@@ -208,7 +207,7 @@ mod tests {
         let io = LabError::io("out/x.csv", "denied");
         assert_eq!(
             (io.to_string().as_str(), io.exit_code()),
-            ("out/x.csv: denied", 1)
+            ("out/x.csv: denied", 2)
         );
     }
 

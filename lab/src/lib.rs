@@ -6,7 +6,8 @@
 //! - `bench`: the estimators against the simulators' truth;
 //! - `sim`: the simulators; `model`: the gyro model, its effects and the
 //!   discovery; `calibration`: thermal, scale factor, lock-in;
-//!   `noise`: the Allan analysis;
+//!   `noise`: the Allan analysis; `record`: what a record is (its
+//!   units, its stationarity, its sampling), checked against the data;
 //! - `data`: the data files; `report`: the HTML/SVG writer;
 //!   `numerics`: what calibration, discovery and noise share; `error`.
 
@@ -21,5 +22,6 @@ pub mod error;
 pub mod model;
 pub mod noise;
 pub mod numerics;
+pub mod record;
 pub mod report;
 pub mod sim;

@@ -422,12 +422,19 @@ fn bad_input_is_one_line_and_exit_2() {
             "too short",
         ),
         (
-            "uneven.csv",
+            // A stretch of a day missing from 1 s rows: not a few lost
+            // frames but another record (uneven rows are analysed, on
+            // their own times: record/sampling.rs).
+            "gap.csv",
             format!(
                 "t_s,rate_dps\n{}",
                 rows(100, &|k| format!(
                     "{},{}\n",
-                    if k == 50 { 50.5 } else { k as f64 },
+                    if k >= 50 {
+                        k as f64 + 86_400.0
+                    } else {
+                        k as f64
+                    },
                     (k as f64).sin()
                 ))
             ),

@@ -151,7 +151,9 @@ fn runs_a_and_b_are_two_runs_of_one_gyro() {
 }
 
 fn read(dir: &std::path::Path, f: &str) -> gyro_lab::model::discovery::Run {
-    gyro_lab::cli::discover::read_run(&dir.join(f)).unwrap()
+    gyro_lab::cli::discover::read_run(&dir.join(f), &Default::default())
+        .unwrap()
+        .0
 }
 
 /// The evidence the bench gathers for a model written on run A.

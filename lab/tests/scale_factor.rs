@@ -308,8 +308,20 @@ fn command_line_round_trip() {
     ]);
     let v: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
     assert!(v["comp_ppm"].as_f64().unwrap() < 1.0, "{v}");
+    // The run as read, its comment lines kept after one naming the
+    // coefficients, with the new column.
     let text = std::fs::read_to_string(p("comp.csv")).unwrap();
-    assert!(text.lines().next().unwrap().ends_with(",rate_comp_dps"));
+    let input = std::fs::read_to_string(p("fit.csv")).unwrap();
+    assert!(text
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("# gyro-lab compensate: "));
+    for c in input.lines().filter(|l| l.starts_with('#')) {
+        assert!(text.contains(c), "comment kept: {c}");
+    }
+    let header = text.lines().find(|l| !l.starts_with('#')).unwrap();
+    assert!(header.ends_with(",rate_comp_dps"), "{header}");
 }
 
 #[test]

@@ -2,7 +2,9 @@
 //! 952 Allan variance, noise/): the JSON, allan.csv and the report.
 
 use crate::cli::adev_plot::{adev_series, misfit_series, missed_series, reading_marks};
-use crate::cli::args::{Json, OutOpt};
+use crate::cli::args::{Json, OutOpt, RunRead};
+use crate::cli::checks;
+use crate::cli::out_path::{self, FileKind};
 use crate::cli::output::write_report;
 use crate::data::allan_file::{self, AllanRow};
 use crate::data::run_file::{Column, Series as RunSeries};
@@ -21,15 +23,17 @@ use std::path::PathBuf;
 const DPH: f64 = 3600.0;
 
 #[derive(Args, Debug, Clone)]
-#[command(mut_arg("out", |a| a.help("Write allan.csv and report.html here")))]
+#[command(mut_arg("out", |a| a.help("A folder: allan.csv and report.html are written in it")))]
 pub struct AllanArgs {
-    /// Run file (t_s and the rate column, deg/s).
+    /// Run file (t_s and the rate column; temperature columns where present).
     #[arg(long)]
     pub data: PathBuf,
-    /// The rate column to analyse, deg/s; less `ref_rate_dps` where the
-    /// file has it.
+    /// The rate column to analyse (our name or the file's); less
+    /// `ref_rate_dps` where the file has it.
     #[arg(long, default_value = Column::Rate.name())]
     pub column: String,
+    #[command(flatten)]
+    pub read: RunRead,
     #[command(flatten)]
     pub out: OutOpt,
     #[command(flatten)]
@@ -117,11 +121,25 @@ fn readings_json(an: &Allan) -> serde_json::Value {
         "floor_tau_s": r.floor_tau_s,
         "bias_instability_dph": r.bias_instability_dph,
         "resolved": r.resolved,
+        "rise_after_floor": r.rise.map(|(t, v)| serde_json::json!({"tau_s": t, "adev_dph": v})),
     })
 }
 
 pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     let t_start = std::time::Instant::now();
+    let spec = a.read.spec()?;
+    if let Some(dir) = &a.out.out {
+        out_path::folder(
+            "allan",
+            dir,
+            &[
+                ("allan.csv", FileKind::Csv),
+                ("report.html", FileKind::Html),
+            ],
+            &[("--data", &a.data)],
+            a.out.force,
+        )?;
+    }
     let big = std::fs::metadata(&a.data).is_ok_and(|m| m.len() > 20_000_000);
     let spinner = if big && !a.json.json {
         let s = indicatif::ProgressBar::new_spinner();
@@ -131,12 +149,30 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let mut series = RunSeries::read(&a.data, &a.column)?;
+    let mut series = RunSeries::read(&a.data, &a.column, &spec)?;
     let read_s = t_start.elapsed().as_secs_f64();
     spinner.set_message("Allan variance");
+    let checked = checks::series(&mut series, &spec)?;
+    let mut warnings = checked.warnings.clone();
+    // A warm-up the temperatures show settling is left out unless the
+    // stretch was given: the noise of the gyro, not its warm-up.
+    let warm_up = match spec.from_s {
+        None => crate::record::stationarity::settled_from(&checked.drifts),
+        Some(_) => None,
+    };
+    if let Some(from) = warm_up {
+        let k = series.t_s.partition_point(|&t| t < from);
+        series.keep_from(k);
+        warnings.push(crate::record::Warning::new(
+            "warm_up",
+            format!(
+                "analysed from {} s on, after the warm-up the temperatures show ({k} rows left out); --from-s 0 analyses the whole record",
+                sig(from)
+            ),
+        ));
+    }
     // The gyro's error, not the table's motion: the output less the
     // reference rate where the file has one.
-    let mut warnings: Vec<RecordWarning> = vec![];
     let analysed = match &series.reference {
         Some(r) => {
             warnings.extend(record_checks::not_static(r));
@@ -147,6 +183,10 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
         }
         None => a.column.clone(),
     };
+    warnings.extend(crate::record::stationarity::mean_rate(
+        &series.t_s,
+        &series.values,
+    ));
     let filled = fill_gaps(&series.t_s, &series.values)
         .map_err(|e| series.time_error(e.row(), e.to_string()))?;
     let name = a.data.display().to_string();
@@ -156,7 +196,7 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     let compute_s = t_start.elapsed().as_secs_f64() - read_s;
     spinner.finish_and_clear();
     if let Some(dir) = &a.out.out {
-        std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
+        out_path::make(dir)?;
         write_csv(&an, &dir.join("allan.csv"))?;
         write_report(
             &report(&an, &name, &analysed, &warnings),
@@ -167,7 +207,9 @@ pub fn run(a: &AllanArgs) -> Result<(), LabError> {
     if a.json.json {
         let mut j = json(&an, &a.column, &filled, timing);
         j["analysed"] = analysed.into();
+        j["analysed_from_s"] = series.t_s.first().copied().into();
         j["warnings"] = serde_json::to_value(&warnings).unwrap_or_default();
+        checked.json(&mut j);
         println!("{j}");
         return Ok(());
     }
@@ -304,9 +346,17 @@ fn readings_text(an: &Allan) -> String {
             num(r.bias_instability_dph)
         )
     } else {
+        let after = match r.rise {
+            Some((t, v)) => format!(
+                "the curve rises after it (to {} deg/h at {} s) but within the 95 % intervals, not beyond the floor's",
+                num(v),
+                sig(t)
+            ),
+            None => "the curve does not rise after it".into(),
+        };
         format!(
-            "lowest point {} deg/h at {} s; the curve does not turn up after it, so the floor is not resolved and \
-             B <= {} deg/h is only an upper bound",
+            "lowest point {} deg/h at {} s; {after}, so the floor is not resolved and B <= {} deg/h is only an \
+             upper bound",
             num(r.floor_dph),
             sig(r.floor_tau_s),
             num(r.bias_instability_dph)

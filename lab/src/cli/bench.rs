@@ -460,7 +460,7 @@ fn csv_read_s(y: &[f64], tau0: f64) -> Result<f64, LabError> {
     }
     w.finish()?;
     let t1 = std::time::Instant::now();
-    let series = Series::read(&path, Column::Rate.name())?;
+    let series = Series::read(&path, Column::Rate.name(), &Default::default())?;
     let read_s = t1.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
     if series.values.len() != y.len() {

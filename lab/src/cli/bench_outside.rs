@@ -185,7 +185,7 @@ fn oracle_model(
 /// Discovery (or the oracle) on a case's run A, and the model it writes
 /// on run B.
 fn one(dir: &Path, t: &CaseTruth, oracle: bool) -> Result<Scored, LabError> {
-    let run = crate::cli::discover::read_run(&dir.join(&t.a.file))?;
+    let run = crate::cli::discover::read_run(&dir.join(&t.a.file), &Default::default())?.0;
     let g = GyroKind::from_name(&t.gyro).ok_or_else(|| {
         LabError::input(dir.join("truth.json"), format!("gyro {:?} unknown", t.gyro))
     })?;
@@ -221,7 +221,7 @@ fn one(dir: &Path, t: &CaseTruth, oracle: bool) -> Result<Scored, LabError> {
             format!("{} rows, the run has {}", ht.len(), inp.t.len()),
         ));
     }
-    let rb = crate::cli::discover::read_run(&dir.join(&t.b.file))?;
+    let rb = crate::cli::discover::read_run(&dir.join(&t.b.file), &Default::default())?.0;
     let yb = model_after.evaluate(&rb.inputs);
     let res_b: Vec<f64> = rb
         .rate

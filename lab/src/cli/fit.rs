@@ -7,20 +7,25 @@ use crate::calibration::scale_factor::fit::fit;
 use crate::calibration::scale_factor::multipoint::Plateau;
 use crate::calibration::scale_factor::result::SfFit;
 use crate::calibration::thermal::summary::{calibrate, FitSummary};
-use crate::cli::args::{Json, NoReport, Out};
-use crate::cli::output::{print_json, write_report};
+use crate::cli::args::{Json, NoReport, Out, RunRead};
+use crate::cli::checks::Checked;
+use crate::cli::out_path::{self, FileKind};
+use crate::cli::output::write_report;
 use crate::cli::reports;
 use crate::cli::run_inputs::{scale_factor_run, thermal_run};
 use crate::error::LabError;
 use clap::Args;
-use gyro_coeffs::file::CoeffFile;
+use gyro_coeffs::file::{CoeffFile, FittedRange};
 use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A file: the coefficient set (TOML, what the firmware loads); its report is written beside it (.html)")))]
 pub struct FitThermalArgs {
     /// Chamber run file (t_s, ref_rate_dps, rate_dps, t_mono_a_c, t_mono_b_c, t_case_c).
     #[arg(long)]
     pub data: PathBuf,
+    #[command(flatten)]
+    pub read: RunRead,
     #[command(flatten)]
     pub out: Out,
     #[command(flatten)]
@@ -37,9 +42,52 @@ struct ThermalJson<'a> {
     report: Option<String>,
 }
 
+/// `--out` for a fit: a TOML file of `kind`, its report beside it.
+fn check_out(
+    command: &str,
+    out: &Out,
+    kind: &'static str,
+    data: &std::path::Path,
+    report: bool,
+) -> Result<(), LabError> {
+    let beside: Vec<_> = match report {
+        true => vec![(out_path::report_beside(&out.out), FileKind::Html)],
+        false => vec![],
+    };
+    out_path::file(
+        command,
+        &out.out,
+        FileKind::Toml(kind),
+        &beside,
+        &[("--data", data)],
+        out.force,
+    )
+}
+
+/// Adds the record checks to a fit's JSON and prints them as text.
+fn emit(c: &Checked, json: Option<serde_json::Value>) -> Result<(), LabError> {
+    match json {
+        Some(mut j) => {
+            c.json(&mut j);
+            println!("{j}");
+        }
+        None => c.print(),
+    }
+    Ok(())
+}
+
 pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
-    let (_, d) = thermal_run(&a.data)?;
-    let s = calibrate(&d).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    let spec = a.read.spec()?;
+    check_out(
+        "fit thermal",
+        &a.out,
+        "rlg_thermal",
+        &a.data,
+        !a.no_report.no_report,
+    )?;
+    let (_, d, checked) = thermal_run(&a.data, &spec)?;
+    let mut s = calibrate(&d).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    s.warnings.splice(0..0, checked.calibration_warnings());
     let c = s.coefficients;
     let mut info = toml::Table::new();
     info.insert("data".into(), a.data.display().to_string().into());
@@ -62,7 +110,10 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
         "record_crc32".into(),
         format!("0x{:08x}", gyro_coeffs::record::crc_of(&c.to_record())).into(),
     );
-    let file = CoeffFile::rlg_thermal(c, info);
+    let mut file = CoeffFile::rlg_thermal(c, info);
+    let lo = s.mono_a_range_c[0].min(s.case_range_c[0]);
+    let hi = s.mono_a_range_c[1].max(s.case_range_c[1]);
+    file.range = Some(FittedRange { temp_c: [lo, hi] });
     gyro_coeffs::file::write(
         &a.out.out,
         &file,
@@ -77,10 +128,12 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
         write_report(&reports::thermal::report(&name, &d, &s), path)?;
     }
     if a.json.json {
-        print_json(&ThermalJson {
+        let j = serde_json::to_value(ThermalJson {
             summary: &s,
             report: report.map(|p| p.display().to_string()),
-        })?;
+        })
+        .unwrap_or_default();
+        emit(&checked, Some(j))?;
     } else {
         let v = s.coefficients.values();
         let e = s.coefficient_se.map(|c| c.values());
@@ -116,11 +169,13 @@ pub fn thermal(a: &FitThermalArgs) -> Result<(), LabError> {
 }
 
 #[derive(Args, Debug, Clone)]
-#[command(mut_arg("out", |a| a.help("Coefficient file to write (what the firmware loads)")))]
+#[command(mut_arg("out", |a| a.help("A file: the coefficient set (TOML, what the firmware loads); its report is written beside it (.html)")))]
 pub struct FitScaleFactorArgs {
     /// Run file: continuous-rotation or multi-point (t_s, ref_rate_dps, rate_dps, temp_c).
     #[arg(long)]
     pub data: PathBuf,
+    #[command(flatten)]
+    pub read: RunRead,
     #[command(flatten)]
     pub out: Out,
     #[command(flatten)]
@@ -157,8 +212,17 @@ struct TableJson {
 }
 
 pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
-    let inp = scale_factor_run(&a.data)?;
-    let (f, plateaus) = fit(&inp).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    let spec = a.read.spec()?;
+    check_out(
+        "fit scale-factor",
+        &a.out,
+        "fog_scale_factor",
+        &a.data,
+        !a.no_report.no_report,
+    )?;
+    let (inp, checked) = scale_factor_run(&a.data, &spec)?;
+    let (mut f, plateaus) = fit(&inp).map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    f.warnings.splice(0..0, checked.calibration_warnings());
     f.table.check().map_err(|_| {
         LabError::input(
             &a.data,
@@ -180,7 +244,7 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
     }
     let n = f.table.n;
     if a.json.json {
-        return print_json(&FitJson {
+        let j = serde_json::to_value(FitJson {
             knees_c: f.knees.iter().map(|k| k.value).collect(),
             knees_ci_c: f.knees.iter().map(|k| [k.lo, k.hi]).collect(),
             residual_ppm: f.residual_ppm.value,
@@ -196,7 +260,9 @@ pub fn scale_factor(a: &FitScaleFactorArgs) -> Result<(), LabError> {
             },
             out: a.out.out.display().to_string(),
             report: report.map(|p| p.display().to_string()),
-        });
+        })
+        .unwrap_or_default();
+        return emit(&checked, Some(j));
     }
     print_text(&f, &crc, &a.out.out);
     if let Some(p) = report {
@@ -218,9 +284,11 @@ fn write_table(a: &FitScaleFactorArgs, f: &SfFit) -> Result<String, LabError> {
     );
     info.insert("residual_ppm".into(), f.residual_ppm.value.into());
     info.insert("record_crc32".into(), crc.clone().into());
+    let mut file = CoeffFile::fog_scale_factor(&f.table, info);
+    file.range = Some(FittedRange { temp_c: f.range_c });
     gyro_coeffs::file::write(
         &a.out.out,
-        &CoeffFile::fog_scale_factor(&f.table, info),
+        &file,
         "FOG scale factor and bias over coil temperature (docs/fog.md), written by gyro-lab fit scale-factor.\n\
          output = (1 + sf_ppm*1e-6)*rate + bias_dph, linear in the coil temperature between the nodes, held outside;\n\
          coil temperature = sensor + sensor_lag_s * d(sensor)/dt. Load with `gyro-lab compensate` or build the\n\

@@ -2,8 +2,9 @@
 //! harmonic relation (calibration/lockin.rs).
 
 use crate::calibration::lockin::{lock_in, LockIn};
-use crate::cli::args::{Json, OutOpt};
-use crate::cli::output::{print_json, write_report};
+use crate::cli::args::{Json, OutOpt, RunRead};
+use crate::cli::out_path::{self, FileKind};
+use crate::cli::output::write_report;
 use crate::cli::reports;
 use crate::data::fringe_file::FringeFile;
 use crate::error::LabError;
@@ -11,11 +12,13 @@ use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
-#[command(mut_arg("out", |a| a.help("Directory to write report.html in")))]
+#[command(mut_arg("out", |a| a.help("A folder: report.html is written in it")))]
 pub struct LockinArgs {
     /// Fringe file: `t_s`, `signal`, optional `signal_q`.
     #[arg(long)]
     pub data: PathBuf,
+    #[command(flatten)]
+    pub read: RunRead,
     /// Scale factor K, pulses (fringes) per degree.
     #[arg(long)]
     pub pulses_per_deg: f64,
@@ -50,7 +53,18 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
             )));
         }
     }
-    let f = FringeFile::read(&a.data, 64)?;
+    let spec = a.read.spec()?;
+    if let Some(dir) = &a.out.out {
+        out_path::folder(
+            "lockin",
+            dir,
+            &[("report.html", FileKind::Html)],
+            &[("--data", &a.data)],
+            a.out.force,
+        )?;
+    }
+    let mut f = FringeFile::read(&a.data, &spec, 64)?;
+    let sampling = crate::record::sampling::regularise(&mut f.t_s);
     let r = lock_in(
         &f.t_s,
         &f.signal,
@@ -61,7 +75,7 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
     .map_err(|e| LabError::input(&a.data, e.to_string()))?;
     let report = match &a.out.out {
         Some(dir) => {
-            std::fs::create_dir_all(dir).map_err(|e| LabError::io(dir, e))?;
+            out_path::make(dir)?;
             let path = dir.join("report.html");
             let name = a.data.display().to_string();
             write_report(
@@ -73,11 +87,22 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
         None => None,
     };
     if a.json.json {
-        print_json(&LockinJson {
+        let mut j = serde_json::to_value(LockinJson {
             r: &r,
             report: report.map(|p| p.display().to_string()),
-        })?;
+        })
+        .unwrap_or_default();
+        j["sampling"] = serde_json::to_value(&sampling).unwrap_or_default();
+        if let Some(w) = sampling.warning() {
+            let mut list = j["warnings"].as_array().cloned().unwrap_or_default();
+            list.push(serde_json::to_value(w).unwrap_or_default());
+            j["warnings"] = list.into();
+        }
+        println!("{j}");
     } else {
+        if let Some(w) = sampling.warning() {
+            println!("WARNING ({}): {}", w.code, w.message);
+        }
         println!(
             "lock-in {:.6} deg/s (+-{:.6}), input rate {:.6} deg/s ({}), beat {:.3} Hz, rho {:.6}",
             r.lock_in_dps,

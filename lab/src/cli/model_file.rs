@@ -84,5 +84,5 @@ fn placed(path: &Path, e: ModelFileError) -> LabError {
 /// Writes a model file, `comment` as `#` lines before it.
 pub fn write_model(path: &Path, model: &Model, comment: &str) -> Result<(), LabError> {
     let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
-    std::fs::write(path, format!("{head}{}", to_toml(model))).map_err(|e| LabError::io(path, e))
+    crate::data::atomic::write(path, format!("{head}{}", to_toml(model)))
 }

@@ -18,7 +18,7 @@ pub fn print_json<T: serde::Serialize>(v: &T) -> Result<(), LabError> {
 
 /// Writes a report's HTML to `path`.
 pub fn write_report(report: &Report, path: &Path) -> Result<(), LabError> {
-    std::fs::write(path, report.html()).map_err(|e| LabError::io(path, e))
+    crate::data::atomic::write(path, report.html())
 }
 
 /// A progress bar of `len` steps drawn with `template`, or a hidden one

@@ -4,7 +4,8 @@
 //! counter), `record.json` (the summary). The decoding and the files are
 //! gyro-frames' `Recorder`, the one `cargo xtask qemu` uses too.
 
-use crate::cli::args::{Json, Out};
+use crate::cli::args::{Json, Out, RunRead};
+use crate::cli::out_path::{self, FileKind};
 use crate::cli::output::print_json;
 use crate::data::run_file::{self, Column};
 use crate::data::table::TextTable;
@@ -36,6 +37,9 @@ pub struct RecordArgs {
     pub from: Option<PathBuf>,
     #[command(flatten)]
     pub out: Out,
+    /// How to read the --reference log (its column names, units, stretch).
+    #[command(flatten)]
+    pub read: RunRead,
     /// Stop after this many seconds (of the host's clock; a capture is read
     /// to its end). Without it a port is read until Ctrl-C or it goes away.
     #[arg(long)]
@@ -212,7 +216,11 @@ fn reference(a: &RecordArgs) -> Result<Reference, LabError> {
     let Some(path) = &a.reference else {
         return Ok(Reference::Constant(0.0));
     };
-    let t = TextTable::read_bounded(path, Some(run_file::bounds))?;
+    let spec = a.read.spec()?;
+    let owned = spec.clone();
+    let rules = Box::new(move |name: &str| run_file::rule(name, &owned));
+    let t = TextTable::read_with(path, &spec, Some(Column::Time.name()), Some(rules))?;
+    t.require(&[Column::Time.name(), Column::RefRate.name()])?;
     let time = t.time(Column::Time.name(), 2)?;
     let rate = t.column(Column::RefRate.name())?;
     RateLog::new(time, rate, a.reference_offset_s)
@@ -253,6 +261,25 @@ pub fn run(a: &RecordArgs) -> Result<(), LabError> {
             )));
         }
     }
+    let mut inputs: Vec<(&str, &Path)> = vec![];
+    if let Some(f) = &a.from {
+        inputs.push(("--from", f));
+    }
+    if let Some(r) = &a.reference {
+        inputs.push(("--reference", r));
+    }
+    out_path::folder(
+        "record",
+        &a.out.out,
+        &[
+            ("raw.bin", FileKind::Binary),
+            ("fog.csv", FileKind::Csv),
+            ("rlg.csv", FileKind::Csv),
+            ("record.json", FileKind::Json),
+        ],
+        &inputs,
+        a.out.force,
+    )?;
     let reference = reference(a)?;
     let (mut source, source_path) = match (&a.port, &a.from) {
         (Some(p), _) => {
@@ -336,7 +363,7 @@ pub fn run(a: &RecordArgs) -> Result<(), LabError> {
     );
     let path = a.out.out.join("record.json");
     let text = serde_json::to_string_pretty(&json).map_err(|e| LabError::io(&path, e))?;
-    std::fs::write(&path, text + "\n").map_err(|e| LabError::io(&path, e))?;
+    crate::data::atomic::write(&path, text + "\n")?;
     if a.json.json {
         print_json(&json)?;
     } else {

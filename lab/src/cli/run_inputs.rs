@@ -1,28 +1,42 @@
-//! Run files turned into what each calibration takes, with the checks a
-//! calibration makes of a run placed at the file's columns.
+//! Run files turned into what each calibration takes, with the record
+//! checks (checks.rs) and the checks a calibration makes of a run placed
+//! at the file's columns.
 
 use crate::calibration::scale_factor::fit::{check_run, RunCheck, MIN_ROTATING_ROWS};
 use crate::calibration::scale_factor::input::{prepare, SfInput, MIN_RATE_DPS, MIN_SPAN_C};
 use crate::calibration::thermal::fit::ThermalData;
-use crate::data::run_file::{Column, RunFile, RunText};
+use crate::cli::checks::{self, Checked};
+use crate::data::read_spec::ReadSpec;
+use crate::data::run_file::{Column, Reference, RunFile, RunText};
 use crate::error::LabError;
 use std::path::Path;
 
 /// A chamber run for the RLG thermal model: at least 200 rows with the two
-/// monoblock sensors and the case sensor.
-pub fn thermal_run(path: &Path) -> Result<(RunText, ThermalData), LabError> {
-    let (text, [a, b, case]) =
-        RunFile::read(path, 200, [Column::MonoA, Column::MonoB, Column::Case])?;
+/// monoblock sensors and the case sensor (a run without `ref_rate_dps` is
+/// a static one, and said so).
+pub fn thermal_run(
+    path: &Path,
+    spec: &ReadSpec,
+) -> Result<(RunText, ThermalData, Checked), LabError> {
+    let (mut text, [a, b, case]) = RunFile::read(
+        path,
+        spec,
+        Reference::ZeroIfAbsent,
+        200,
+        [Column::MonoA, Column::MonoB, Column::Case],
+    )?;
+    let c = checks::run(&mut text.run, spec)?;
     let r = &text.run;
     let d = ThermalData::new(r.t_s.clone(), (a, b), case, &r.rate_dps, &r.ref_rate_dps);
-    Ok((text, d))
+    Ok((text, d, c))
 }
 
 /// A run for the scale-factor fit, checked: `t_s`, `ref_rate_dps`,
 /// `rate_dps`, `temp_c`; rotation present; a temperature span the model
 /// can use.
-pub fn scale_factor_run(path: &Path) -> Result<SfInput, LabError> {
-    let (text, [temp]) = RunFile::read(path, 30, [Column::Temp])?;
+pub fn scale_factor_run(path: &Path, spec: &ReadSpec) -> Result<(SfInput, Checked), LabError> {
+    let (mut text, [temp]) = RunFile::read(path, spec, Reference::Required, 30, [Column::Temp])?;
+    let c = checks::run(&mut text.run, spec)?;
     let r = &text.run;
     check_run(&r.ref_rate_dps, &temp).map_err(|e| match e {
         RunCheck::NoRotation(rows) => text.column_error(
@@ -40,5 +54,5 @@ pub fn scale_factor_run(path: &Path) -> Result<SfInput, LabError> {
             ),
         ),
     })?;
-    Ok(prepare(&r.t_s, &r.ref_rate_dps, &r.rate_dps, &temp))
+    Ok((prepare(&r.t_s, &r.ref_rate_dps, &r.rate_dps, &temp), c))
 }

@@ -31,7 +31,7 @@ pub struct AllanRow<'a> {
 
 pub fn write(path: &Path, rows: &[AllanRow]) -> Result<(), LabError> {
     let io = |e: std::io::Error| LabError::io(path, e);
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    let mut w = super::atomic::AtomicFile::create(path)?;
     writeln!(w, "{}", COLUMNS.join(",")).map_err(io)?;
     for r in rows {
         writeln!(
@@ -47,5 +47,5 @@ pub fn write(path: &Path, rows: &[AllanRow]) -> Result<(), LabError> {
         )
         .map_err(io)?;
     }
-    w.flush().map_err(io)
+    w.commit()
 }

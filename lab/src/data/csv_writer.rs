@@ -1,8 +1,10 @@
 //! Writing numeric CSV files row by row: `#` comment lines, the header, then
 //! one row per call, each column with its own number format. Rows are
 //! streamed (a long simulation's run file is never held whole). The file
-//! kinds give the column names; this module knows none.
+//! kinds give the column names; this module knows none. The file appears
+//! under its name only at [`CsvWriter::finish`] (atomic.rs).
 
+use super::atomic::AtomicFile;
 use crate::error::LabError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -19,7 +21,7 @@ pub enum CellFormat {
 }
 
 pub struct CsvWriter {
-    w: std::io::BufWriter<std::fs::File>,
+    w: AtomicFile,
     path: PathBuf,
     formats: Vec<CellFormat>,
 }
@@ -32,8 +34,7 @@ impl CsvWriter {
         columns: &[(&str, CellFormat)],
     ) -> Result<Self, LabError> {
         let io = |e: std::io::Error| LabError::io(path, e);
-        let file = std::fs::File::create(path).map_err(io)?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 16, file);
+        let mut w = AtomicFile::create(path)?;
         for l in comment.lines() {
             writeln!(w, "# {l}").map_err(io)?;
         }
@@ -66,7 +67,7 @@ impl CsvWriter {
         self.w.write_all(b"\n")
     }
 
-    pub fn finish(mut self) -> Result<(), LabError> {
-        self.w.flush().map_err(|e| LabError::io(&self.path, e))
+    pub fn finish(self) -> Result<(), LabError> {
+        self.w.commit()
     }
 }

@@ -3,6 +3,7 @@
 //! in quadrature.
 
 use super::csv_writer::{CellFormat, CsvWriter};
+use super::read_spec::ReadSpec;
 use super::run_file::Column;
 use super::table::TextTable;
 use crate::error::LabError;
@@ -35,9 +36,25 @@ pub struct FringeFile {
 }
 
 impl FringeFile {
-    /// Reads a fringe file of at least `min_rows` rows, time increasing.
-    pub fn read(path: &Path, min_rows: usize) -> Result<Self, LabError> {
-        let table = TextTable::read(path)?;
+    /// Reads a fringe file of at least `min_rows` rows (in the stretch
+    /// asked for), time increasing, its columns mapped by `spec`.
+    pub fn read(path: &Path, spec: &ReadSpec, min_rows: usize) -> Result<Self, LabError> {
+        for (ours, _) in &spec.rename {
+            let names = [
+                FringeColumn::Time,
+                FringeColumn::Signal,
+                FringeColumn::SignalQ,
+            ]
+            .map(FringeColumn::name);
+            if !names.contains(&ours.as_str()) {
+                return Err(LabError::Usage(format!(
+                    "--columns: `{ours}` is not a fringe-file column ({})",
+                    names.join(", ")
+                )));
+            }
+        }
+        let table = TextTable::read_with(path, spec, Some(FringeColumn::Time.name()), None)?;
+        table.require(&[FringeColumn::Time.name(), FringeColumn::Signal.name()])?;
         Ok(Self {
             t_s: table.time(FringeColumn::Time.name(), min_rows)?,
             signal: table.column(FringeColumn::Signal.name())?,

@@ -4,8 +4,14 @@
 //! places every error at its file, line and column.
 
 pub mod allan_file;
+pub mod atomic;
 pub mod csv_writer;
+pub mod dialect;
 pub mod fringe_file;
+pub mod header;
+pub mod read_spec;
 pub mod residual_file;
 pub mod run_file;
 pub mod table;
+pub mod timestamp;
+pub mod units;

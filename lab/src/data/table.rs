@@ -1,31 +1,57 @@
-//! Reading CSV data files by column name: CSV, one header row, `#` comment
-//! lines before it. Every row must have as many cells as the header: a row
-//! with one more or one less would shift or drop a column, and the answer
-//! would change without a word. Every cell a caller uses is checked: a
-//! missing column (at the header's own line), a cell that is not a finite
-//! number, time that does not increase or too few rows give an error at
-//! `file:line:column` (column = 1-based field number, then its name). The
-//! file kinds (run_file.rs, fringe_file.rs) name the columns; this module
-//! knows none.
+//! Reading CSV data files by column name: one header row, `#` comment
+//! lines before it, a byte-order mark before those, cells separated by a
+//! comma, a semicolon or a tab (dialect.rs). Every row must have as many
+//! cells as the header: a row with one more or one less would shift or
+//! drop a column, and the answer would change without a word. Every cell a
+//! caller uses is checked: missing columns (all of them, with the columns
+//! the file has, at the header's own line), a cell that is not a finite
+//! number or is outside its column's physical range, time that does not
+//! increase or too few rows give an error at `file:line:column` (column =
+//! 1-based field number, then its name). The user's names are mapped onto
+//! ours and the units converted here (read_spec.rs); the file kinds
+//! (run_file.rs, fringe_file.rs) name the columns and their rules; this
+//! module knows none.
 //!
 //! Two readers: [`TextTable`] keeps the file as text cells (unused columns
 //! are written back as read) and checks column by column; [`ColumnStream`]
 //! reads long records in one pass without the text and checks row by row.
 
+use super::dialect::{header_line, strip_bom, Dialect};
+use super::header::{Header, Places};
+use super::read_spec::{ColumnRule, ReadSpec, Rules};
+use super::timestamp;
 use crate::error::{ColumnRef, LabError};
 use std::path::{Path, PathBuf};
 
-/// The physical range of a column's values, looked up by its name (the
-/// file kinds know their columns; this module knows none): `(lo, hi,
-/// what)`, `what` naming the range in the error.
-pub type Bounds = fn(&str) -> Option<(f64, f64, &'static str)>;
+/// What a reader is asked for: the spec the user gave, the rules of the
+/// file kind, and which column is time (its cells may be clock
+/// timestamps, its unit is the spec's, and the stretch asked for is cut
+/// on it).
+#[derive(Clone, Copy)]
+pub struct Plan<'a> {
+    pub spec: &'a ReadSpec,
+    pub rules: Option<Rules<'a>>,
+    pub time: Option<&'a str>,
+}
+
+impl Plan<'static> {
+    /// Read as written: no mapping, no units, no checks, no stretch.
+    pub fn plain() -> Self {
+        static PLAIN: std::sync::OnceLock<ReadSpec> = std::sync::OnceLock::new();
+        Plan {
+            spec: PLAIN.get_or_init(ReadSpec::default),
+            rules: None,
+            time: None,
+        }
+    }
+}
 
 /// What is wrong with a cell that should hold a number.
 enum CellError<'a> {
     NotFinite(&'a str),
     Empty,
     NotANumber(&'a str),
-    OutOfRange(&'a str, &'static str),
+    OutOfRange(String),
 }
 
 impl std::fmt::Display for CellError<'_> {
@@ -34,26 +60,49 @@ impl std::fmt::Display for CellError<'_> {
             CellError::NotFinite(c) => write!(f, "`{c}` is not a finite number"),
             CellError::Empty => f.write_str("empty cell"),
             CellError::NotANumber(c) => write!(f, "cannot read `{c}` as a number"),
-            CellError::OutOfRange(c, what) => write!(f, "`{c}` is outside {what}"),
+            CellError::OutOfRange(m) => f.write_str(m),
         }
     }
 }
 
-/// A cell as a finite number, within `range` where the column has one.
-fn number<'a>(
-    cell: &'a str,
-    range: Option<(f64, f64, &'static str)>,
-) -> Result<f64, CellError<'a>> {
-    match cell.parse::<f64>() {
-        Ok(v) if v.is_finite() => match range {
-            Some((lo, hi, what)) if !(lo..=hi).contains(&v) => {
-                Err(CellError::OutOfRange(cell, what))
-            }
-            _ => Ok(v),
-        },
-        Ok(_) => Err(CellError::NotFinite(cell)),
-        Err(_) if cell.is_empty() => Err(CellError::Empty),
-        Err(_) => Err(CellError::NotANumber(cell)),
+/// How one requested column's cells become numbers.
+struct Reader {
+    rule: ColumnRule,
+    dialect: Dialect,
+    /// The time column: numbers in the spec's unit, or clock timestamps
+    /// (seconds since the first row's).
+    time: Option<f64>,
+    clock_origin: Option<f64>,
+}
+
+impl Reader {
+    fn new(plan: &Plan, name: &str, dialect: Dialect) -> Self {
+        let is_time = plan.time == Some(name);
+        Self {
+            rule: plan.rules.map_or_else(ColumnRule::plain, |r| r(name)),
+            dialect,
+            time: is_time.then(|| plan.spec.time_unit.unwrap_or_default().to_s()),
+            clock_origin: None,
+        }
+    }
+
+    fn read<'a>(&mut self, cell: &'a str) -> Result<f64, CellError<'a>> {
+        let v = match self.dialect.parse(cell) {
+            Ok(v) if v.is_finite() => match self.time {
+                Some(unit) => v * unit,
+                None => self.rule.scale * v + self.rule.offset,
+            },
+            Ok(_) => return Err(CellError::NotFinite(cell)),
+            Err(_) if cell.is_empty() => return Err(CellError::Empty),
+            Err(_) => match self.time.and_then(|_| timestamp::parse(cell)) {
+                Some(s) => s - *self.clock_origin.get_or_insert(s),
+                None => return Err(CellError::NotANumber(cell)),
+            },
+        };
+        match self.rule.check.as_ref().and_then(|c| c(v)) {
+            Some(m) => Err(CellError::OutOfRange(format!("`{cell}` {m}"))),
+            None => Ok(v),
+        }
     }
 }
 
@@ -100,39 +149,69 @@ fn column_ref(field: usize, name: &str) -> ColumnRef {
     }
 }
 
+fn csv_reader<R: std::io::Read>(d: Dialect, r: R) -> csv::Reader<R> {
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(d.delimiter)
+        .buffer_capacity(1 << 20)
+        .from_reader(r)
+}
+
 /// A data file held as text cells, with the line number of every row.
 pub struct TextTable {
     pub path: PathBuf,
-    pub header: Vec<String>,
+    pub header: Header,
     header_line: u64,
     rows: Vec<(u64, Vec<String>)>,
-    bounds: Option<Bounds>,
+    /// The comment lines before the header, as written.
+    comments: Vec<String>,
+    dialect: Dialect,
+    spec: ReadSpec,
+    rules: Option<Box<dyn Fn(&str) -> ColumnRule + 'static>>,
+    /// The time column's name, and its values once read (cut to the
+    /// stretch asked for).
+    time_name: Option<String>,
+    time: Option<Vec<f64>>,
 }
 
 impl TextTable {
+    /// Reads as written (no mapping, units or stretch).
     pub fn read(path: &Path) -> Result<Self, LabError> {
-        Self::read_bounded(path, None)
+        Self::read_with(path, &ReadSpec::default(), None, None)
     }
 
-    /// Reads, checking every numeric column's cells against `bounds`.
-    pub fn read_bounded(path: &Path, bounds: Option<Bounds>) -> Result<Self, LabError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
+    /// Reads with the user's `spec`: the `time` column (if any) is read
+    /// first, and the rows outside the stretch asked for are dropped;
+    /// `rules` are the file kind's for every column read.
+    pub fn read_with(
+        path: &Path,
+        spec: &ReadSpec,
+        time: Option<&str>,
+        rules: Option<Box<dyn Fn(&str) -> ColumnRule + 'static>>,
+    ) -> Result<Self, LabError> {
+        let bytes =
+            std::fs::read(path).map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
+        let (bytes, _) = strip_bom(&bytes);
+        let text = String::from_utf8_lossy(bytes);
+        let dialect = Dialect::of_header(header_line(text.as_bytes()));
         // Comment lines before the header are skipped by hand so that line
         // numbers stay those of the file.
         let (skipped, offset) = leading_comments(text.as_bytes());
-        let mut rdr = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(&text.as_bytes()[offset..]);
+        let comments: Vec<String> = text[..offset]
+            .lines()
+            .filter(|l| l.trim_start().starts_with('#'))
+            .map(str::to_owned)
+            .collect();
+        let mut rdr = csv_reader(dialect, &text.as_bytes()[offset..]);
         let mut records = rdr.records();
-        let header: Vec<String> = match records.next() {
-            Some(Ok(r)) => r.iter().map(str::to_owned).collect(),
+        let names: Vec<String> = match records.next() {
+            Some(Ok(r)) => r.iter().map(|c| c.trim().to_owned()).collect(),
             Some(Err(e)) => return Err(LabError::input(path, e.to_string())),
             None => return Err(LabError::input(path, "no header row")),
         };
         let header_line = skipped + 1;
+        let header = Header::new(names, spec);
         let mut rows = Vec::new();
         for rec in records {
             let rec = rec.map_err(|e| {
@@ -140,21 +219,40 @@ impl TextTable {
                 LabError::at_line(path, line, e.to_string())
             })?;
             let line = rec.position().map_or(0, |p| p.line()) + skipped;
-            if rec.iter().all(str::is_empty) {
+            if rec.iter().all(|c| c.trim().is_empty()) {
                 continue;
             }
             if rec.len() != header.len() {
                 return Err(width_error(path, line, rec.len(), header.len()));
             }
-            rows.push((line, rec.iter().map(str::to_owned).collect()));
+            rows.push((line, rec.iter().map(|c| c.trim().to_owned()).collect()));
         }
-        Ok(Self {
+        let mut t = Self {
             path: path.to_owned(),
             header,
             header_line,
             rows,
-            bounds,
-        })
+            comments,
+            dialect,
+            spec: spec.clone(),
+            rules,
+            time_name: time.map(str::to_owned),
+            time: None,
+        };
+        if let Some(tc) = time {
+            let v = t.column(tc)?;
+            let keep: Vec<bool> = v.iter().map(|&x| t.spec.keeps(x)).collect();
+            let mut k = keep.iter();
+            t.rows.retain(|_| *k.next().unwrap_or(&false));
+            let v: Vec<f64> = v
+                .into_iter()
+                .zip(&keep)
+                .filter(|p| *p.1)
+                .map(|p| p.0)
+                .collect();
+            t.time = Some(v);
+        }
+        Ok(t)
     }
 
     pub fn len(&self) -> usize {
@@ -166,39 +264,75 @@ impl TextTable {
     }
 
     pub fn has(&self, col: &str) -> bool {
-        self.header.iter().any(|h| h == col)
+        self.header.find(col).is_some()
+    }
+
+    /// All of `cols` present, else one error listing every one missing.
+    pub fn require(&self, cols: &[&str]) -> Result<(), LabError> {
+        self.header
+            .require(&self.path, self.header_line, cols)
+            .map(|_| ())
     }
 
     fn index(&self, col: &str) -> Result<usize, LabError> {
-        self.header.iter().position(|h| h == col).ok_or_else(|| {
-            LabError::at_line(
-                &self.path,
-                self.header_line,
-                format!("missing column `{col}`"),
-            )
-        })
+        self.header
+            .require(&self.path, self.header_line, &[col])
+            .map(|v| v[0])
+    }
+
+    /// Where `cols` (ours) are: the path, the header's line, and per
+    /// column present its field and the name the file gives it.
+    pub fn places(&self, cols: &[&str]) -> Places {
+        Places {
+            path: self.path.clone(),
+            header_line: self.header_line,
+            fields: cols
+                .iter()
+                .filter_map(|c| {
+                    self.header
+                        .find(c)
+                        .map(|i| (c.to_string(), i + 1, self.header.shown(c).to_owned()))
+                })
+                .collect(),
+        }
     }
 
     /// An error about column `col` as a whole, placed at its header cell.
     pub fn column_error(&self, col: &str, msg: impl Into<String>) -> LabError {
-        let i = self
-            .header
-            .iter()
-            .position(|h| h == col)
-            .map_or(0, |i| i + 1);
-        LabError::at(&self.path, self.header_line, column_ref(i, col), msg)
+        let i = self.header.find(col).map_or(0, |i| i + 1);
+        LabError::at(
+            &self.path,
+            self.header_line,
+            column_ref(i, self.header.shown(col)),
+            msg,
+        )
     }
 
-    /// A numeric column: every cell a finite number.
+    /// A numeric column: every cell a finite number inside its range.
     pub fn column(&self, col: &str) -> Result<Vec<f64>, LabError> {
+        if let (Some(name), Some(v)) = (&self.time_name, &self.time) {
+            if name == col {
+                return Ok(v.clone());
+            }
+        }
         let i = self.index(col)?;
-        let range = self.bounds.and_then(|b| b(col));
+        let plan = Plan {
+            spec: &self.spec,
+            rules: self.rules.as_deref(),
+            time: self.time_name.as_deref(),
+        };
+        let mut reader = Reader::new(&plan, col, self.dialect);
         self.rows
             .iter()
             .map(|(line, cells)| {
                 let cell = cells.get(i).map(String::as_str).unwrap_or("");
-                number(cell, range).map_err(|m| {
-                    LabError::at(&self.path, *line, column_ref(i + 1, col), m.to_string())
+                reader.read(cell).map_err(|m| {
+                    LabError::at(
+                        &self.path,
+                        *line,
+                        column_ref(i + 1, self.header.shown(col)),
+                        m.to_string(),
+                    )
                 })
             })
             .collect()
@@ -214,22 +348,28 @@ impl TextTable {
     }
 
     /// The time column `col`, strictly increasing, with at least `min_rows`
-    /// rows.
+    /// rows (in the stretch asked for).
     pub fn time(&self, col: &str, min_rows: usize) -> Result<Vec<f64>, LabError> {
+        let t = self.column(col)?;
         if self.rows.len() < min_rows {
             return Err(LabError::input(
                 &self.path,
-                format!("{} data rows, at least {min_rows} needed", self.rows.len()),
+                format!(
+                    "{} data rows{}, at least {min_rows} needed",
+                    self.rows.len(),
+                    self.spec
+                        .stretch()
+                        .map_or(String::new(), |s| format!(" in the stretch {s}"))
+                ),
             ));
         }
-        let t = self.column(col)?;
         let i = self.index(col)?;
         for k in 1..t.len() {
             if t[k] <= t[k - 1] {
                 return Err(LabError::at(
                     &self.path,
                     self.rows[k].0,
-                    column_ref(i + 1, col),
+                    column_ref(i + 1, self.header.shown(col)),
                     format!("time {} does not increase (previous {})", t[k], t[k - 1]),
                 ));
             }
@@ -237,43 +377,66 @@ impl TextTable {
         Ok(t)
     }
 
-    /// Writes the table back with extra numeric columns appended.
-    pub fn write_with(&self, out: &Path, extra: &[(&str, &[f64])]) -> Result<(), LabError> {
-        let io = |e: csv::Error| LabError::io(out, e);
-        let mut w = csv::Writer::from_path(out).map_err(io)?;
-        let mut head = self.header.clone();
-        head.extend(extra.iter().map(|(n, _)| n.to_string()));
-        w.write_record(&head).map_err(io)?;
-        for (k, (_, cells)) in self.rows.iter().enumerate() {
-            let mut rec = cells.clone();
-            rec.extend(extra.iter().map(|(_, v)| format!("{:.9}", v[k])));
-            w.write_record(&rec).map_err(io)?;
+    /// The table's rows as text with extra numeric columns appended:
+    /// `comment` as `#` lines first, then the file's own comment lines,
+    /// the header and the rows in the file's separator.
+    pub fn text_with(&self, comment: &str, extra: &[(&str, &[f64])]) -> String {
+        let d = self.dialect.delimiter as char;
+        let mut s = String::with_capacity(64 * (self.rows.len() + 1));
+        for l in comment.lines() {
+            s.push_str("# ");
+            s.push_str(l);
+            s.push('\n');
         }
-        w.flush().map_err(|e| LabError::io(out, e))
+        for l in &self.comments {
+            s.push_str(l);
+            s.push('\n');
+        }
+        let quote = |c: &str| {
+            if c.contains(d) || c.contains('"') {
+                format!("\"{}\"", c.replace('"', "\"\""))
+            } else {
+                c.to_owned()
+            }
+        };
+        let mut head: Vec<String> = self.header.names().iter().map(|c| quote(c)).collect();
+        head.extend(extra.iter().map(|(n, _)| n.to_string()));
+        s.push_str(&head.join(&d.to_string()));
+        s.push('\n');
+        for (k, (_, cells)) in self.rows.iter().enumerate() {
+            let mut rec: Vec<String> = cells.iter().map(|c| quote(c)).collect();
+            rec.extend(extra.iter().map(|(_, v)| format!("{:.9}", v[k])));
+            s.push_str(&rec.join(&d.to_string()));
+            s.push('\n');
+        }
+        s
     }
 }
 
 /// Numeric columns of a long record, read in one pass without keeping the
 /// text (a 10^7-row run file as a [`TextTable`] would be gigabytes of
-/// strings). The same checks and messages as [`TextTable`]: a missing
-/// column, an empty or non-numeric cell, NaN or infinity give
-/// `file:line:column`.
+/// strings). The same checks and messages as [`TextTable`].
 pub struct ColumnStream {
     pub path: PathBuf,
     pub header_line: u64,
     /// One vector per requested column, in the order asked.
     pub data: Vec<Vec<f64>>,
-    /// The requested columns' names, in the order of `data`.
+    /// The requested columns' names (ours), in the order of `data`.
     pub names: Vec<String>,
+    /// The requested columns' names as the file has them.
+    pub shown: Vec<String>,
     /// File line of every row.
     pub lines: Vec<u64>,
     /// 1-based field number of every requested column.
     pub fields: Vec<usize>,
 }
 
-/// Consumes the comment and blank lines before the header; returns their
-/// count.
+/// Consumes a byte-order mark and the comment and blank lines before the
+/// header; returns their count.
 fn skip_leading_comments(r: &mut impl std::io::BufRead) -> std::io::Result<u64> {
+    let buf = r.fill_buf()?;
+    let bom = strip_bom(buf).1;
+    r.consume(bom);
     let mut n = 0;
     loop {
         let buf = r.fill_buf()?;
@@ -291,43 +454,34 @@ fn skip_leading_comments(r: &mut impl std::io::BufRead) -> std::io::Result<u64> 
 }
 
 impl ColumnStream {
+    /// `cols`, read as written.
     pub fn read(path: &Path, cols: &[&str]) -> Result<Self, LabError> {
-        Self::read_with(path, cols, &[]).map(|(c, _)| c)
+        Self::read_plan(path, cols, &[], Plan::plain()).map(|(c, _)| c)
     }
 
     /// `required` columns, and of `optional` those the file has: returns
     /// the columns (required first, then the optional ones present) and,
-    /// per optional column, its index in `data` if present.
-    pub fn read_with(
+    /// per optional column, its index in `data` if present. The rows
+    /// outside the plan's stretch are dropped (their cells unread but for
+    /// time).
+    pub fn read_plan(
         path: &Path,
         required: &[&str],
         optional: &[&str],
+        plan: Plan,
     ) -> Result<(Self, Vec<Option<usize>>), LabError> {
-        Self::read_bounded(path, required, optional, None)
-    }
-
-    /// [`Self::read_with`], every cell checked against `bounds`.
-    pub fn read_bounded(
-        path: &Path,
-        required: &[&str],
-        optional: &[&str],
-        bounds: Option<Bounds>,
-    ) -> Result<(Self, Vec<Option<usize>>), LabError> {
+        use std::io::BufRead;
         let mut file = std::io::BufReader::with_capacity(
             1 << 20,
             std::fs::File::open(path)
                 .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?,
         );
+        let cant = |e: std::io::Error| LabError::input(path, format!("cannot read: {e}"));
         // The comment lines before the header are skipped by hand, so the
-        // reader's line numbers are the file's plus their count (its own
-        // comment skipping does not count them).
-        let skipped = skip_leading_comments(&mut file)
-            .map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;
-        let mut rdr = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .buffer_capacity(1 << 20)
-            .from_reader(file);
+        // reader's line numbers are the file's plus their count.
+        let skipped = skip_leading_comments(&mut file).map_err(cant)?;
+        let dialect = Dialect::of_header(header_line(file.fill_buf().map_err(cant)?));
+        let mut rdr = csv_reader(dialect, file);
         let mut rec = csv::ByteRecord::new();
         let at = |e: csv::Error| {
             let line = e.position().map_or(0, |p| p.line()) + skipped;
@@ -337,21 +491,21 @@ impl ColumnStream {
             return Err(LabError::input(path, "no header row"));
         }
         let header_line = rec.position().map_or(1, |p| p.line()) + skipped;
-        let header: Vec<String> = rec
-            .iter()
-            .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
-            .collect();
-        let mut fields = Vec::new();
+        let header = Header::new(
+            rec.iter()
+                .map(|f| String::from_utf8_lossy(f.trim_ascii()).into_owned())
+                .collect(),
+            plan.spec,
+        );
         let mut cols: Vec<&str> = required.to_vec();
-        for c in required {
-            let i = header.iter().position(|h| h == c).ok_or_else(|| {
-                LabError::at_line(path, header_line, format!("missing column `{c}`"))
-            })?;
-            fields.push(i + 1);
-        }
+        let mut fields: Vec<usize> = header
+            .require(path, header_line, required)?
+            .into_iter()
+            .map(|i| i + 1)
+            .collect();
         let mut present = vec![];
         for c in optional {
-            match header.iter().position(|h| h == c) {
+            match header.find(c) {
                 Some(i) => {
                     present.push(Some(cols.len()));
                     cols.push(c);
@@ -360,24 +514,40 @@ impl ColumnStream {
                 None => present.push(None),
             }
         }
-        let ranges: Vec<_> = cols.iter().map(|c| bounds.and_then(|b| b(c))).collect();
+        let mut readers: Vec<Reader> = cols
+            .iter()
+            .map(|c| Reader::new(&plan, c, dialect))
+            .collect();
+        let time_k = plan.time.and_then(|t| cols.iter().position(|c| *c == t));
+        let shown: Vec<String> = cols.iter().map(|c| header.shown(c).to_owned()).collect();
         let mut data: Vec<Vec<f64>> = cols.iter().map(|_| Vec::new()).collect();
         let mut lines = Vec::new();
+        let width = header.len();
         while rdr.read_byte_record(&mut rec).map_err(at)? {
             let line = rec.position().map_or(0, |p| p.line()) + skipped;
-            // Cells are trimmed here, only those read: the reader's own
-            // trimming of every field cost a third of a long record's read.
             if rec.iter().all(|f| f.trim_ascii().is_empty()) {
                 continue;
             }
-            if rec.len() != header.len() {
-                return Err(width_error(path, line, rec.len(), header.len()));
+            if rec.len() != width {
+                return Err(width_error(path, line, rec.len(), width));
             }
-            for (k, &f) in fields.iter().enumerate() {
-                let cell = rec.get(f - 1).unwrap_or(b"").trim_ascii();
-                let text = std::str::from_utf8(cell).unwrap_or("");
-                let v = number(text, ranges[k])
-                    .map_err(|m| LabError::at(path, line, column_ref(f, cols[k]), m.to_string()))?;
+            let cell = |k: usize, readers: &mut [Reader]| {
+                let f = fields[k];
+                let text =
+                    std::str::from_utf8(rec.get(f - 1).unwrap_or(b"").trim_ascii()).unwrap_or("");
+                readers[k]
+                    .read(text)
+                    .map_err(|m| LabError::at(path, line, column_ref(f, &shown[k]), m.to_string()))
+            };
+            if let Some(k) = time_k {
+                let t = cell(k, &mut readers)?;
+                if !plan.spec.keeps(t) {
+                    continue;
+                }
+                data[k].push(t);
+            }
+            for k in (0..cols.len()).filter(|&k| Some(k) != time_k) {
+                let v = cell(k, &mut readers)?;
                 data[k].push(v);
             }
             lines.push(line);
@@ -388,6 +558,7 @@ impl ColumnStream {
                 header_line,
                 data,
                 names: cols.iter().map(|c| (*c).to_owned()).collect(),
+                shown,
                 lines,
                 fields,
             },
@@ -409,7 +580,7 @@ impl ColumnStream {
         LabError::at(
             &self.path,
             line,
-            column_ref(self.fields[k], &self.names[k]),
+            column_ref(self.fields[k], &self.shown[k]),
             msg,
         )
     }

@@ -44,8 +44,8 @@ pub const MAX_GAP_SAMPLES: f64 = 10_000.0;
 /// Make `values` at times `t` uniform. Intervals within
 /// [`SAMPLING_TOLERANCE`] of the median pass; a record of only those is
 /// returned as it is. Longer intervals (up to [`MAX_GAP_SAMPLES`]) are gaps,
-/// and the record is resampled through its angle. A shorter interval, or a
-/// longer gap, is an error at its row.
+/// shorter ones rows taken early: either way the record is resampled
+/// through its angle. A longer gap is an error at its row.
 pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
     let n = t.len().min(values.len());
     let uniform = |tau0| Filled {
@@ -71,17 +71,18 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
         if (h - med).abs() <= tol {
             continue;
         }
-        if !(h > med && h <= MAX_GAP_SAMPLES * med) {
-            // A short interval after a long one: the row between them is
-            // the one whose time is off.
-            let displaced = k > 0 && h < med && d[k - 1] > med + tol;
+        if h > MAX_GAP_SAMPLES * med {
             return Err(SamplingError::Uneven {
-                row: if displaced { k } else { k + 1 },
+                row: k + 1,
                 interval: h,
                 median: med,
             });
         }
-        if h >= 1.5 * med {
+        if h < med {
+            // A row taken early (irregular sampling, record/sampling.rs
+            // keeps such times): resampled through the angle like the rest.
+            stretched += 1;
+        } else if h >= 1.5 * med {
             gaps += 1;
         } else {
             stretched += 1;
@@ -161,16 +162,16 @@ mod tests {
     }
 
     #[test]
-    fn a_short_or_repeated_interval_is_an_error_at_its_row() {
-        let t = [0.0, 1.0, 2.0, 2.5, 3.5, 4.5];
-        let e = fill_gaps(&t, &[0.0; 6]).unwrap_err();
-        assert_eq!(e.row(), 3);
-        // A displaced time: the long interval before it passes as a gap,
-        // the short one after it names the displaced row.
-        let t = [0.0, 1.0, 2.0, 3.5, 4.0, 5.0];
-        assert_eq!(fill_gaps(&t, &[0.0; 6]).unwrap_err().row(), 3);
-        let t = [0.0, 1.0, 2.0, 2.0, 3.0];
-        assert_eq!(fill_gaps(&t, &[0.0; 5]).unwrap_err().row(), 3);
+    fn irregular_rows_keep_the_angle_and_a_day_long_gap_is_an_error() {
+        // Rows at uneven times, each the mean rate since the row before.
+        let t = [0.0, 1.0, 2.0, 2.5, 3.5, 4.5, 6.0];
+        let y = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let f = fill_gaps(&t, &y).unwrap();
+        let angle: f64 = f.values[1..].iter().sum::<f64>() * f.tau0;
+        let truth: f64 = (1..7).map(|i| y[i] * (t[i] - t[i - 1])).sum();
+        assert!((angle - truth).abs() < 1e-12, "{angle} vs {truth}");
+        let t = [0.0, 1.0, 2.0, 20_000.0];
+        assert_eq!(fill_gaps(&t, &[0.0; 4]).unwrap_err().row(), 3);
     }
 
     #[test]

@@ -28,6 +28,9 @@ pub struct Readings {
     /// Whether the curve rises significantly after the floor (a later
     /// point's interval wholly above the floor's).
     pub resolved: bool,
+    /// The highest point after the floor (tau s, deg/h), where one is
+    /// above it: a rise the intervals may or may not resolve.
+    pub rise: Option<(f64, f64)>,
 }
 
 /// Least-squares slope of ln y on ln x over points i in `idx`.
@@ -115,7 +118,12 @@ pub fn read(taus: &[f64], adev: &[f64], lo: &[f64], hi: &[f64]) -> Readings {
         .unwrap_or(0);
     let floor = adev.get(imin).copied().unwrap_or(f64::NAN);
     let resolved = (imin + 1..n).any(|i| lo[i] > hi[imin]);
+    let rise = (imin + 1..n)
+        .filter(|&i| adev[i] > floor)
+        .max_by(|&a, &b| adev[a].total_cmp(&adev[b]))
+        .map(|i| (taus[i], adev[i]));
     Readings {
+        rise,
         arw_dpsh,
         arw_region_s: run.map(|(a, b)| (taus[a], taus[b])),
         floor_dph: floor,

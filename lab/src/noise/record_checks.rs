@@ -16,12 +16,7 @@ pub const STATIC_TOLERANCE_DPS: f64 = 0.01;
 /// handful of the record's longest averages.
 pub const MIN_EDF: f64 = 4.0;
 
-/// A warning on the record: `code` for scripts, `message` for people.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct RecordWarning {
-    pub code: &'static str,
-    pub message: String,
-}
+pub use crate::record::Warning as RecordWarning;
 
 /// `not_static` when the reference rate varies over the record.
 pub fn not_static(reference_dps: &[f64]) -> Option<RecordWarning> {

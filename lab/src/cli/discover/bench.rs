@@ -215,14 +215,15 @@ pub fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
                 (j, v)
             }
             None => {
-                let run = crate::cli::discover::read_run(&csv)?;
+                let run = crate::cli::discover::read_run(&csv, &Default::default())?.0;
                 let g = GyroKind::from_name(&t.gyro).unwrap_or(GyroKind::Fog);
                 let d = run_discover(&Model::ideal(g), &run, &Default::default());
                 // A second day of the same gyro: the model written must
                 // predict it up to a bias.
                 let v = match &t.validate {
                     Some(f) => {
-                        let r2 = crate::cli::discover::read_run(&a.runs.join(f))?;
+                        let r2 =
+                            crate::cli::discover::read_run(&a.runs.join(f), &Default::default())?.0;
                         let opts = Options {
                             grade: Some(d.grade.value),
                         };

@@ -5,11 +5,14 @@
 pub mod bench;
 pub mod report;
 
-use crate::cli::args::{Json, Out};
+use crate::cli::args::{Json, Out, RunRead};
+use crate::cli::checks::{self, Checked};
 use crate::cli::model_file::{read_model_file, write_model};
+use crate::cli::out_path::{self, FileKind};
 use crate::cli::output::write_report;
+use crate::data::read_spec::ReadSpec;
 use crate::data::residual_file;
-use crate::data::run_file::{Column, RunFile};
+use crate::data::run_file::{Column, Reference, RunFile};
 use crate::error::LabError;
 use crate::model::discovery::estimates::Estimate;
 use crate::model::discovery::result::TermFound;
@@ -66,6 +69,7 @@ impl From<GradeArg> for Grade {
 }
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A folder: model.toml, residual.csv and report.html are written in it")))]
 pub struct DiscoverArgs {
     /// The gyro the run is from: its kind sets the ideal model and the library of effects.
     #[arg(long, value_enum)]
@@ -81,20 +85,25 @@ pub struct DiscoverArgs {
     /// The model (model.toml); the ideal gyro without it.
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Run file (t_s, ref_rate_dps, rate_dps; temp_c, t_mono_a_c,
-    /// t_mono_b_c, t_case_c, ref_acc_dps2 where the effects need them).
+    /// Run file (t_s, rate_dps, ref_rate_dps unless static; temp_c,
+    /// t_mono_a_c, t_mono_b_c, t_case_c, ref_acc_dps2 where the effects
+    /// need them).
     #[arg(long)]
     pub data: PathBuf,
+    #[command(flatten)]
+    pub read: RunRead,
     #[command(flatten)]
     pub out: Out,
     #[command(flatten)]
     pub json: Json,
 }
 
-/// Reads a run file for discovery.
-pub fn read_run(path: &Path) -> Result<Run, LabError> {
-    let r = RunFile::read_long(
+/// Reads a run file for discovery, with the record checks.
+pub fn read_run(path: &Path, spec: &ReadSpec) -> Result<(Run, Checked), LabError> {
+    let mut r = RunFile::read_long(
         path,
+        spec,
+        Reference::ZeroIfAbsent,
         10,
         &[
             Column::Temp,
@@ -104,21 +113,25 @@ pub fn read_run(path: &Path) -> Result<Run, LabError> {
             Column::RefAcc,
         ],
     )?;
+    let checked = checks::run(&mut r, spec)?;
     let mono = match (r.t_mono_a_c, r.t_mono_b_c) {
         (Some(a), Some(b)) => Some((a, b)),
         _ => None,
     };
-    Ok(Run {
-        inputs: Inputs::new(
-            r.t_s,
-            r.ref_rate_dps,
-            r.temp_c,
-            mono,
-            r.t_case_c,
-            r.ref_acc_dps2,
-        ),
-        rate: r.rate_dps,
-    })
+    Ok((
+        Run {
+            inputs: Inputs::new(
+                r.t_s,
+                r.ref_rate_dps,
+                r.temp_c,
+                mono,
+                r.t_case_c,
+                r.ref_acc_dps2,
+            ),
+            rate: r.rate_dps,
+        },
+        checked,
+    ))
 }
 
 /// An estimate's JSON: parameters and their 95 % intervals.
@@ -297,12 +310,31 @@ fn computable(model: &Model, run: &Run, path: &Path) -> Result<(), LabError> {
 
 pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     let t0 = std::time::Instant::now();
+    let spec = a.read.spec()?;
+    let mut inputs: Vec<(&str, &Path)> = vec![("--data", &a.data)];
+    if let Some(p) = &a.model {
+        inputs.push(("--model", p));
+    }
+    if let Some(p) = &a.validate {
+        inputs.push(("--validate", p));
+    }
+    out_path::folder(
+        "discover",
+        &a.out.out,
+        &[
+            ("model.toml", FileKind::Toml("gyro_model")),
+            ("residual.csv", FileKind::Csv),
+            ("report.html", FileKind::Html),
+        ],
+        &inputs,
+        a.out.force,
+    )?;
     let gyro = GyroKind::from(a.gyro);
     let file = match &a.model {
         Some(p) => Some(read_model_file(p, gyro)?),
         None => None,
     };
-    let data = read_run(&a.data)?;
+    let (data, checked) = read_run(&a.data, &spec)?;
     let model = match &file {
         Some(f) => {
             f.check_on_run(&run_extent(&data))?;
@@ -321,7 +353,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
     // misses there.
     let validation = match &a.validate {
         Some(p) => {
-            let v = read_run(p)?;
+            let (v, _) = read_run(p, &spec)?;
             computable(&d.model_after, &v, p)?;
             let opts_v = Options {
                 grade: Some(d.grade.value),
@@ -353,9 +385,11 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
             }
         }
         j["elapsed_s"] = t0.elapsed().as_secs_f64().into();
+        checked.json(&mut j);
         println!("{j}");
         return Ok(());
     }
+    checked.print();
     print_text(a, &d);
     if let Some((p, v, terms)) = &validation {
         print_validation(p, v);
@@ -491,7 +525,7 @@ fn run_extent(data: &Run) -> Extent {
 /// report, in `--out`.
 fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabError> {
     let out = &a.out.out;
-    std::fs::create_dir_all(out).map_err(|e| LabError::io(out, e))?;
+    out_path::make(out)?;
     let mut names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
     names.extend(
         d.terms

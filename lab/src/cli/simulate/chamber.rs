@@ -30,6 +30,7 @@ impl From<ChamberProfileArg> for ChamberProfile {
 }
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A file: the run file to write (CSV)")))]
 pub struct ChamberArgs {
     /// Chamber temperature profile.
     #[arg(long, value_enum, default_value_t = ChamberProfileArg::Cycle)]

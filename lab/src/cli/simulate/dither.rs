@@ -14,7 +14,7 @@ use gyro_sim::rlg_dither::{Accuracy, DitherParams};
 #[derive(Args, Debug, Clone)]
 #[command(
     mut_arg("seed", |a| a.help("Seed of the dither's amplitude noise and the photodiodes' noise")),
-    mut_arg("out", |a| a.help("Write a run file at the frame rate (500 Hz)"))
+    mut_arg("out", |a| a.help("A file: a run file to write at the frame rate (500 Hz)"))
 )]
 pub struct DitherArgs {
     /// Lock-in rate Omega_L, deg/s.

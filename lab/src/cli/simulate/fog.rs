@@ -12,7 +12,7 @@ use clap::Args;
 #[derive(Args, Debug, Clone)]
 #[command(
     mut_arg("seed", |a| a.help("Noise seed")),
-    mut_arg("out", |a| a.help("Write a run file (CSV, means over 25 closure steps)"))
+    mut_arg("out", |a| a.help("A file: a run file to write (CSV, means over 25 closure steps)"))
 )]
 pub struct FogArgs {
     /// Bias modulation depth phi0, rad.

@@ -9,6 +9,7 @@ use clap::Args;
 
 /// `gyro-lab simulate lockin`: writes a fringe file.
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A file: the fringe file to write (CSV)")))]
 pub struct LockinSimArgs {
     /// Input rate Omega_I, deg/s.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]

@@ -10,8 +10,10 @@ pub mod outside;
 pub mod run;
 pub mod scale_factor;
 
+use crate::cli::out_path::{self, FileKind};
 use crate::error::LabError;
 use clap::Subcommand;
+use std::path::Path;
 
 #[derive(Subcommand)]
 pub enum SimulateCmd {
@@ -33,7 +35,41 @@ pub enum SimulateCmd {
     Outside(outside::OutsideArgs),
 }
 
+/// The run file a simulation writes: refused where it names the model
+/// read, exists without `--force`, or is not a CSV's name.
+fn check_out(
+    command: &str,
+    out: Option<&Path>,
+    force: bool,
+    inputs: &[(&str, &Path)],
+) -> Result<(), LabError> {
+    match out {
+        Some(o) => out_path::file(command, o, FileKind::Csv, &[], inputs, force),
+        None => Ok(()),
+    }
+}
+
 pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
+    match cmd {
+        SimulateCmd::Fog(a) => check_out("simulate fog", a.out.out.as_deref(), a.out.force, &[])?,
+        SimulateCmd::Lockin(a) => check_out("simulate lockin", Some(&a.out.out), a.out.force, &[])?,
+        SimulateCmd::Chamber(a) => {
+            check_out("simulate chamber", Some(&a.out.out), a.out.force, &[])?
+        }
+        SimulateCmd::Dither(a) => {
+            check_out("simulate dither", a.out.out.as_deref(), a.out.force, &[])?
+        }
+        SimulateCmd::ScaleFactor(a) => {
+            check_out("simulate scale-factor", Some(&a.out.out), a.out.force, &[])?
+        }
+        SimulateCmd::Run(a) => check_out(
+            "simulate run",
+            Some(&a.out.out),
+            a.out.force,
+            &[("--model", &a.model)],
+        )?,
+        SimulateCmd::Heldout(_) | SimulateCmd::Outside(_) => {}
+    }
     match cmd {
         SimulateCmd::Fog(a) => fog::run(a),
         SimulateCmd::Lockin(a) => lockin::run(a),

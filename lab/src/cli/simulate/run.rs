@@ -97,6 +97,7 @@ pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> Result<()
 }
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A file: the run file to write (CSV)")))]
 pub struct SimulateRunArgs {
     /// The truth: a model file (its gyro kind must match the profile's).
     #[arg(long)]

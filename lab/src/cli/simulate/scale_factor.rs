@@ -59,6 +59,7 @@ pub enum TestKind {
 }
 
 #[derive(Args, Debug, Clone)]
+#[command(mut_arg("out", |a| a.help("A file: the run file to write (CSV)")))]
 pub struct SimulateArgs {
     /// The calibration test: continuous rotation through the chamber sweep, or the classic
     /// multi-point plateaus.
