@@ -75,7 +75,7 @@ pub struct RunRead {
     /// rate's (a table's log in deg/s beside a gyro's in rad/s).
     #[arg(long, value_name = "UNIT")]
     pub ref_rate_unit: Option<RateUnit>,
-    /// The unit of the file's temperature columns: C (default) or K.
+    /// The unit of the file's temperature columns: C (default), K or F.
     #[arg(long, value_name = "UNIT")]
     pub temp_unit: Option<TempUnit>,
     /// The unit of the file's time column: s (default), ms or us (clock

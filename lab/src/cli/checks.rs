@@ -111,6 +111,7 @@ fn check(
         .iter()
         .filter_map(|(n, v)| stationarity::temperature(t, n, v))
         .collect();
+    warnings.extend(hot(temps, spec));
     Ok(Checked {
         warnings,
         sampling,
@@ -119,6 +120,31 @@ fn check(
         spec: spec.clone(),
         rows: t.len(),
         has_reference: reference.is_some(),
+    })
+}
+
+/// Above what most gyros are rated for (+85 degC): a degF file read as
+/// degC reads 68 to 185 for 20 to 85 degC, inside the sensors' range.
+pub const RATED_MAX_C: f64 = 90.0;
+
+/// A warning where a temperature column reads hotter than gyros run and
+/// its values as degF would be ordinary ones.
+fn hot(temps: &[(String, &[f64])], spec: &ReadSpec) -> Option<Warning> {
+    if spec.temp_unit.is_some() {
+        return None;
+    }
+    let (name, max) = temps
+        .iter()
+        .map(|(n, v)| (n, v.iter().copied().fold(f64::NEG_INFINITY, f64::max)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let as_c = crate::data::units::TempUnit::Fahrenheit.to_c(max);
+    (max > RATED_MAX_C).then(|| {
+        Warning::new(
+            "unit",
+            format!(
+                "`{name}` reaches {max:.1} degC, above the +85 degC most gyros are rated for; as degF it would be {as_c:.1} degC: is the file in degF? (--temp-unit F, degC = (degF - 32) * 5/9)"
+            ),
+        )
     })
 }
 

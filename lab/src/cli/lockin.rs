@@ -39,6 +39,10 @@ struct LockinJson<'a> {
     report: Option<String>,
 }
 
+/// The least lock-in rate a ring laser gyro has, deg/s (physics.md 2.1
+/// gives 0.01 .. 0.5 for the reference gyros).
+pub const LOCK_IN_MIN_DPS: f64 = 0.002;
+
 pub fn run(a: &LockinArgs) -> Result<(), LabError> {
     if !(a.pulses_per_deg.is_finite() && a.pulses_per_deg > 0.0) {
         return Err(LabError::Usage(format!(
@@ -65,7 +69,7 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
     }
     let mut f = FringeFile::read(&a.data, &spec, 64)?;
     let sampling = crate::record::sampling::regularise(&mut f.t_s);
-    let r = lock_in(
+    let mut r = lock_in(
         &f.t_s,
         &f.signal,
         f.signal_q.as_deref(),
@@ -73,6 +77,17 @@ pub fn run(a: &LockinArgs) -> Result<(), LabError> {
         a.input_rate_dps,
     )
     .map_err(|e| LabError::input(&a.data, e.to_string()))?;
+    // Lock-in rates of real RLGs are 0.01 .. 1 deg/s (physics.md 2.1): far
+    // below, the record's time or K is likely in another unit.
+    if r.lock_in_dps < LOCK_IN_MIN_DPS {
+        r.warnings.push(crate::calibration::warning::Warning::new(
+            "unit",
+            format!(
+                "a lock-in of {} deg/s is below any RLG's ({LOCK_IN_MIN_DPS} deg/s at least): is the time column in ms (--time-unit ms, a factor of 1000) or K in another unit?",
+                crate::report::text::sig(r.lock_in_dps)
+            ),
+        ));
+    }
     let report = match &a.out.out {
         Some(dir) => {
             out_path::make(dir)?;

@@ -38,13 +38,31 @@ pub fn scale_factor_run(path: &Path, spec: &ReadSpec) -> Result<(SfInput, Checke
     let (mut text, [temp]) = RunFile::read(path, spec, Reference::Required, 30, [Column::Temp])?;
     let c = checks::run(&mut text.run, spec)?;
     let r = &text.run;
+    if let Some(w) = c.warnings.iter().find(|w| w.code == "sign") {
+        return Err(text.column_error(
+            Column::Rate,
+            format!(
+                "{}; a scale factor cannot be fitted across the sign: negate the rate column (or the reference) so they agree",
+                w.message
+                    .split(';')
+                    .next()
+                    .unwrap_or(&w.message)
+            ),
+        ));
+    }
+    let peak = r.ref_rate_dps.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     check_run(&r.ref_rate_dps, &temp).map_err(|e| match e {
         RunCheck::NoRotation(rows) => text.column_error(
             Column::RefRate,
             format!(
-                "no rotation: {rows} rows with |{}| >= {} deg/s, at least {MIN_ROTATING_ROWS} needed to measure a scale factor",
+                "no rotation: {rows} rows with |{}| >= {} deg/s, at least {MIN_ROTATING_ROWS} needed to measure a scale factor{}",
                 Column::RefRate.name(),
-                MIN_RATE_DPS
+                MIN_RATE_DPS,
+                if spec.rate_unit.is_none() && peak > 0.0 && peak * crate::data::units::DEG_PER_RAD >= MIN_RATE_DPS {
+                    format!(" (the table reaches {peak:.4}: if the file is in rad/s, give --rate-unit rad/s)")
+                } else {
+                    String::new()
+                }
             ),
         ),
         RunCheck::Span(span) => text.column_error(

@@ -155,14 +155,24 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
             ),
         }
     } else if name.ends_with("_dps") {
+        let given = spec.rate_unit.is_some();
         ColumnRule {
             scale: rate.to_dps(),
             offset: 0.0,
-            check: range(
-                -1e5,
-                1e5,
-                "the rates a gyro or a rate table gives (|x| <= 1e5 deg/s)",
-            ),
+            check: Some(Box::new(move |v: f64| {
+                const MAX: f64 = 1e5;
+                (v.abs() > MAX).then(|| {
+                    let hint = if !given && (v / 3600.0).abs() <= MAX {
+                        format!(
+                            "; as deg/h it is {} deg/s: is the file in deg/h? (--rate-unit deg/h)",
+                            v / 3600.0
+                        )
+                    } else {
+                        String::new()
+                    };
+                    format!("is outside the rates a gyro or a rate table gives (|x| <= 1e5 deg/s){hint}")
+                })
+            })),
         }
     } else if name.ends_with("_deg") {
         ColumnRule {
@@ -176,21 +186,22 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
         let unit = unit.unwrap_or_default();
         let (lo, hi) = TEMP_RANGE_C;
         ColumnRule {
-            scale: 1.0,
+            scale: unit.scale(),
             offset: unit.to_c(0.0),
             check: Some(Box::new(move |v: f64| {
                 if (lo..=hi).contains(&v) {
                     return None;
                 }
-                let as_k = v - ZERO_C_IN_K;
-                let raw = v - unit.to_c(0.0);
+                let raw = (v - unit.to_c(0.0)) / unit.scale();
+                let as_k = raw - ZERO_C_IN_K;
                 Some(if unit == TempUnit::Celsius && (lo..=hi).contains(&as_k) {
                     format!(
                         "is outside the {lo}..+{hi} degC a gyro's sensors read; as kelvin it is {as_k:.2} degC: give --temp-unit K"
                     )
-                } else if unit == TempUnit::Kelvin && (lo..=hi).contains(&raw) {
+                } else if unit != TempUnit::Celsius && (lo..=hi).contains(&raw) {
                     format!(
-                        "is {v:.2} degC as kelvin, outside the {lo}..+{hi} degC a gyro's sensors read; as degC it is {raw}: drop --temp-unit K"
+                        "is {v:.2} degC with --temp-unit {}, outside the {lo}..+{hi} degC a gyro's sensors read; as degC it is {raw}: drop --temp-unit",
+                        unit.name()
                     )
                 } else {
                     format!(

@@ -77,6 +77,7 @@ pub enum TempUnit {
     #[default]
     Celsius,
     Kelvin,
+    Fahrenheit,
 }
 
 impl TempUnit {
@@ -85,6 +86,15 @@ impl TempUnit {
         match self {
             TempUnit::Celsius => v,
             TempUnit::Kelvin => v - ZERO_C_IN_K,
+            TempUnit::Fahrenheit => (v - 32.0) * 5.0 / 9.0,
+        }
+    }
+
+    /// degC per unit of a difference.
+    pub fn scale(self) -> f64 {
+        match self {
+            TempUnit::Fahrenheit => 5.0 / 9.0,
+            _ => 1.0,
         }
     }
 
@@ -92,6 +102,7 @@ impl TempUnit {
         match self {
             TempUnit::Celsius => "C",
             TempUnit::Kelvin => "K",
+            TempUnit::Fahrenheit => "F",
         }
     }
 }
@@ -102,8 +113,9 @@ impl FromStr for TempUnit {
         match s.trim() {
             "C" | "c" | "degC" | "degc" | "celsius" => Ok(TempUnit::Celsius),
             "K" | "k" | "kelvin" => Ok(TempUnit::Kelvin),
+            "F" | "f" | "degF" | "degf" | "fahrenheit" => Ok(TempUnit::Fahrenheit),
             _ => Err(LabError::Usage(format!(
-                "`{s}` is not a temperature unit: C or K"
+                "`{s}` is not a temperature unit: C, K or F"
             ))),
         }
     }
@@ -198,6 +210,7 @@ mod tests {
         assert!((RateUnit::RadPerS.to_dps() - 57.29577951308232).abs() < 1e-12);
         assert_eq!(RateUnit::DegPerH.to_dps() * 3600.0, 1.0);
         assert_eq!(TempUnit::Kelvin.to_c(293.15), 20.0);
+        assert!((TempUnit::Fahrenheit.to_c(68.0) - 20.0).abs() < 1e-12);
         for (s, u) in [
             ("deg/s", RateUnit::DegPerS),
             ("rad/s", RateUnit::RadPerS),

@@ -49,6 +49,34 @@ fn alternatives(read_as: RateUnit) -> Vec<(RateUnit, f64)> {
         .collect()
 }
 
+/// The Earth's rate, deg/h.
+pub const EARTH_DPH: f64 = 15.041;
+
+/// Where a slope (or ratio) of the rate on its reference is a unit's
+/// factor to within `tol`: which column is in which unit, in words.
+fn mixed_units(s: f64, read_as: RateUnit, ref_as: RateUnit, tol: f64) -> Option<String> {
+    let near = |f: f64| (s.abs() / f - 1.0).abs() < tol;
+    for u in RateUnit::ALL {
+        // The rate in u: it reads 1/f of the reference.
+        let f = u.to_dps() / read_as.to_dps();
+        if u != read_as && near(1.0 / f) {
+            return Some(format!(
+                "a factor of {} where a gyro's scale factor is 1 to within percents. Is the rate in {u} and the reference in {ref_as}? Give the rate's unit with --rate-unit {u} (and the reference's with --ref-rate-unit {ref_as})",
+                factor_text(1.0 / f)
+            ));
+        }
+        // The reference in u: the rate reads f of it.
+        let g = u.to_dps() / ref_as.to_dps();
+        if u != ref_as && near(g) {
+            return Some(format!(
+                "a factor of {} where a gyro's scale factor is 1 to within percents. Is the reference in {u} and the rate in {read_as}? Give the reference's unit with --ref-rate-unit {u}",
+                factor_text(g)
+            ));
+        }
+    }
+    None
+}
+
 /// A factor in words (57.3, 1/57.3, 3600, 1/3600).
 pub fn factor_text(f: f64) -> String {
     if f >= 1.0 {
@@ -151,6 +179,7 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
             ));
         }
     }
+    let ref_as = c.reference_given.or(c.given).unwrap_or_default();
     // 1: the reference, where the table turns.
     if let Some(w) = c.reference_dps {
         let (lo, hi) = w.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
@@ -158,16 +187,9 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
         });
         if hi - lo > 1.0 && c.rate_dps.len() >= 10 {
             let s = slope(w, c.rate_dps);
-            let near = |f: f64| (s.abs() / f - 1.0).abs() < 0.05;
-            if let Some((u, f)) = alternatives(read_as)
-                .into_iter()
-                .find(|(_, f)| near(1.0 / f))
-            {
-                return Err(Refusal(format!(
-                    "the rate follows the reference (which turns {lo:.3} .. {hi:.3} deg/s) with a slope of {}: a factor of {} where a gyro's scale factor is 1 to within percents. Is the rate in {u} and the reference in {read_as}? Give the rate's unit with --rate-unit and the reference's with --ref-rate-unit",
-                    crate::report::text::sig(s),
-                    factor_text(1.0 / f),
-                )));
+            let what = format!("the rate follows the reference (which turns {lo:.3} .. {hi:.3} deg/s) with a slope of {}", crate::report::text::sig(s));
+            if let Some(m) = mixed_units(s, read_as, ref_as, 0.05) {
+                return Err(Refusal(format!("{what}: {m}")));
             }
             if (s + 1.0).abs() < 0.1 {
                 out.warnings.push(Warning::new(
@@ -190,22 +212,38 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
             return Ok(out);
         }
     }
-    // A table held at one rate: the mean follows it with a ratio of 1.
+    // A table held at one rate, or the Earth-rate component at rest: the
+    // mean follows it with a ratio of 1 (less a bias).
     if let Some(w) = c.reference_dps {
         let (r0, _) = mean_sd(w);
-        if r0.abs() > 1.0 && c.rate_dps.len() >= 10 {
-            let (m, _) = mean_sd(c.rate_dps);
-            let ratio = m / r0;
-            if let Some((u, f)) = alternatives(read_as)
-                .into_iter()
-                .find(|(_, f)| (ratio.abs() * f - 1.0).abs() < 0.05)
-            {
+        let (m, _) = mean_sd(c.rate_dps);
+        let sd = white_sd(c.rate_dps);
+        let se = sd / (c.rate_dps.len() as f64).sqrt();
+        let ratio = m / r0;
+        let far = (m - r0).abs() > 10.0 * se && (ratio.abs() > 20.0 || ratio.abs() < 0.05);
+        if r0 != 0.0 && se < 0.02 * m.abs() && far && c.rate_dps.len() >= 10 {
+            if let Some(msg) = mixed_units(ratio, read_as, ref_as, 0.1) {
                 return Err(Refusal(format!(
-                    "the mean rate is {} times the table's constant {} deg/s: a factor of {} where a gyro's scale factor is 1 to within percents. Is the rate in {u} and the reference in {read_as}? Give the rate's unit with --rate-unit and the reference's with --ref-rate-unit",
+                    "the mean rate, {} deg/s, is {} times the constant reference ({} deg/s): {msg}",
+                    crate::report::text::sig(m),
                     crate::report::text::sig(ratio),
-                    crate::report::text::sig(r0),
-                    factor_text(1.0 / f),
+                    crate::report::text::sig(r0)
                 )));
+            }
+        }
+        if r0.abs() > 1.0 && c.rate_dps.len() >= 10 {
+            if (1.0..=15.05).contains(&r0.abs())
+                && ref_as == RateUnit::DegPerS
+                && (ratio - 1.0).abs() < 0.2
+            {
+                out.warnings.push(Warning::new(
+                    "unit",
+                    format!(
+                        "the reference is a constant {} deg/s: a rate table held there, or, if the file is in deg/h, the Earth-rate component at rest ({} deg/h at most): is it? (--rate-unit deg/h, a factor of 1/3600)",
+                        crate::report::text::sig(r0),
+                        crate::report::text::sig(EARTH_DPH)
+                    ),
+                ));
             }
             out.basis =
                 format!("the mean rate against the table's constant rate: a ratio of {ratio:.6}");
@@ -218,30 +256,6 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
     };
     let (mean_bias, _) = mean_sd(&bias);
     let sd = white_sd(&bias);
-    // 3: a constant non-zero reference the mean is a factor of.
-    if let Some(w) = c.reference_dps {
-        let (r0, _) = mean_sd(w);
-        let (m, _) = mean_sd(c.rate_dps);
-        let se = sd / (c.rate_dps.len() as f64).sqrt();
-        if r0.abs() > 20.0 * se && r0 != 0.0 && (m - r0).abs() > 10.0 * se {
-            if let Some((u, f)) = alternatives(read_as)
-                .into_iter()
-                .find(|(_, f)| ((m * f) / r0 - 1.0).abs() < 0.02)
-            {
-                out.warnings.push(Warning::new(
-                    "unit",
-                    format!(
-                        "the mean rate, {} deg/s, is the constant reference {} deg/s times {} to 2 %: is the rate in {u}? (--rate-unit {u})",
-                        crate::report::text::sig(m),
-                        crate::report::text::sig(r0),
-                        factor_text(1.0 / f)
-                    ),
-                ));
-                out.basis = "the mean rate against the constant reference".into();
-                return Ok(out);
-            }
-        }
-    }
     // 4: a grid of round degrees that is not one of the unit read.
     if let Some(q) = grid_step(&bias) {
         if !round_decimal(q) {

@@ -246,6 +246,14 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "found": found,
         "gap_before_dph": d.gap_before_dph,
         "gap_after_dph": d.gap_after_dph,
+        "gap_window_s": gap_window_s(d),
+        "residual_mean": {
+            "value_dph": d.residual_mean_dph,
+            "sd_dph": d.residual_mean_sd_dph,
+            "lo_dph": d.residual_mean_dph - 1.96 * d.residual_mean_sd_dph,
+            "hi_dph": d.residual_mean_dph + 1.96 * d.residual_mean_sd_dph,
+            "centred_by_dph": d.centred_by_dph,
+        },
         "noise_floor_dph": d.noise_floor_dph,
         "noise_floor_hi_dph": d.noise_floor_hi_dph,
         "noise_floor_white_dph": d.noise_floor_white_dph,
@@ -584,14 +592,46 @@ fn params_text(e: &Estimate) -> String {
         .join(", ")
 }
 
+/// What the gap's means are over: 1 s windows, or the rows themselves
+/// where they are further apart.
+pub fn gap_window_s(d: &Discovery) -> f64 {
+    let t = &d.windows.t;
+    let mut g: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    if g.is_empty() {
+        return WINDOW_S;
+    }
+    let k = g.len() / 2;
+    let med = *g.select_nth_unstable_by(k, f64::total_cmp).1;
+    med.max(WINDOW_S)
+}
+
+/// "1 s means", or "the rows (15 s each)" where the rows are longer.
+pub fn gap_means_text(d: &Discovery) -> String {
+    let w = gap_window_s(d);
+    if w > 1.5 * WINDOW_S {
+        format!("its rows ({} s each)", sig(w))
+    } else {
+        format!("{WINDOW_S} s means")
+    }
+}
+
 fn print_text(a: &DiscoverArgs, d: &Discovery) {
     let out = &a.out.out;
     println!(
-        "{}: gap (RMS of {} s means of measured - model) {:.4} deg/h; noise floor there {:.4} deg/h",
+        "{}: gap (RMS of {} of measured - model) {:.4} deg/h; noise floor there {:.4} deg/h",
         a.data.display(),
-        WINDOW_S,
+        gap_means_text(d),
         d.gap_before_dph,
         d.noise_floor_dph
+    );
+    println!(
+        "grade: {} ({})",
+        d.grade.value,
+        if d.grade.inferred {
+            d.grade.reason.clone()
+        } else {
+            "given".into()
+        }
     );
     for s in &d.skipped {
         let names: Vec<&str> = s.missing.iter().map(|c| c.name()).collect();
@@ -711,6 +751,17 @@ fn print_text(a: &DiscoverArgs, d: &Discovery) {
     if let Some(f) = &d.fallback {
         println!("note: {f}");
     }
+    println!(
+        "the residual after the model averages {:.4} deg/h over the record (95 % interval {:.4} .. {:.4}{})",
+        d.residual_mean_dph,
+        d.residual_mean_dph - 1.96 * d.residual_mean_sd_dph,
+        d.residual_mean_dph + 1.96 * d.residual_mean_sd_dph,
+        if d.centred_by_dph != 0.0 {
+            format!("; the model's constant moved by {:.4} deg/h to the residual's mean", d.centred_by_dph)
+        } else {
+            String::new()
+        }
+    );
     println!(
         "gap {:.4} -> {:.4} deg/h; written {}, residual.csv, report.html",
         d.gap_before_dph,

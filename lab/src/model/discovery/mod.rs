@@ -18,6 +18,7 @@
 //! 4. The model with the named and carried effects added, checked never to
 //!    explain less than the one it started from.
 
+pub mod centre;
 pub mod confirm;
 pub mod constant;
 pub mod design;
@@ -32,6 +33,7 @@ pub mod result;
 pub mod select;
 pub mod terms;
 pub mod transients;
+pub mod trend;
 pub mod unexplained;
 pub mod white;
 pub mod windows;
@@ -414,7 +416,10 @@ fn window_spacing(win: &Windows) -> f64 {
 /// and after, and what stays unexplained.
 pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let first = discover_library(model, run, opts);
-    outside::beyond(model, run, opts, first, &discover_library)
+    centre::centre(
+        run,
+        outside::beyond(model, run, opts, first, &discover_library),
+    )
 }
 
 /// [`discover`] with the library's effects alone (the model's terms held
@@ -678,6 +683,17 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
             .sqrt();
         unexplained = Some(unexplained::beyond_floor(&d, &noise, &after_w, excess, why));
     }
+    // What a function of the inputs explains that the noise model took
+    // as its own (trend.rs): said, not absorbed.
+    if short.is_none() && unexplained.is_none() {
+        if let Some(tr) = trend::input_trend(inp, &win, &after_w, &d.wh.keep) {
+            let slow = (
+                noise.random_walk.sqrt() * 216_000.0,
+                noise.flicker.sqrt() * 3600.0,
+            );
+            unexplained = Some(tr.unexplained(&win, slow));
+        }
+    }
     let allan_after = allan_of(&inp.t, &r_after);
     let keep = d.wh.keep.clone();
     drop(d);
@@ -711,5 +727,8 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
         keep,
         terms: vec![],
         proposals: Default::default(),
+        residual_mean_dph: f64::NAN,
+        residual_mean_sd_dph: f64::NAN,
+        centred_by_dph: 0.0,
     }
 }

@@ -234,6 +234,32 @@ fn refit_users(
     (m, cur)
 }
 
+/// The label of a function of the inputs offered by trend.rs.
+pub const TREND_LABEL: &str =
+    "a trend a temperature explains, preferred to the slow noise that could carry it as well";
+
+/// Where no candidate predicts what is left against the noise model, but
+/// a function of the inputs predicts it against the white noise (trend.rs:
+/// the noise model took it as its own), that function is offered: the
+/// physical reading of what the inputs explain. It joins the model only
+/// where it closes the gap as any proposal must.
+fn trend_proposal(cur: &Discovery) -> Option<crate::model::proposal::Proposed> {
+    let it = cur.unexplained.as_ref()?.input_term.clone()?;
+    let term = Term::new(&it.formula, it.params.clone()).ok()?;
+    Some(crate::model::proposal::Proposed {
+        label: TREND_LABEL,
+        term,
+        intervals: it.intervals,
+        validation: Validation {
+            folds: crate::model::proposal::validation::FOLDS,
+            held_out_gain: it.held_out_gain,
+            fold_gains: vec![],
+            threshold: crate::model::proposal::validation::THRESHOLD,
+            held_out_share: f64::NAN,
+        },
+    })
+}
+
 /// Discovery with the terms beyond the library: `first` is the library's
 /// discovery on `given`.
 pub fn beyond(
@@ -274,7 +300,11 @@ pub fn beyond(
     // of the excess above the floor it closed.
     let mut closure: Vec<(f64, f64, f64)> = vec![];
     while cur.unexplained.is_some() && proposed.len() < MAX_PROPOSED {
-        if cur.gap_after_dph < MIN_GAP_OVER_FLOOR * cur.noise_floor_dph {
+        let from_inputs = cur
+            .unexplained
+            .as_ref()
+            .is_some_and(|u| u.input_function.is_some());
+        if cur.gap_after_dph < MIN_GAP_OVER_FLOOR * cur.noise_floor_dph && !from_inputs {
             log.note = Some(format!(
                 "the gap after the model, {:.4} deg/h, is less than {MIN_GAP_OVER_FLOOR} times the noise floor ({:.4} deg/h): what stands above the floor is too little to propose a term for",
                 cur.gap_after_dph, cur.noise_floor_dph
@@ -286,7 +316,10 @@ pub fn beyond(
         let fit = fit_columns(given, &cur, inp, &rows, None);
         let p = propose(inp, &y, &fit, &|x| rows.dph(x));
         log.tried = p.tried;
-        let Some(pr) = p.proposed else {
+        let Some(pr) = p
+            .proposed
+            .or_else(|| from_inputs.then(|| trend_proposal(&cur)).flatten())
+        else {
             log.note = Some(match log.tried.first() {
                 Some(b) => format!(
                     "no term built from the run's inputs predicts what is left on data it was not fitted on: the best, {} ({}), gains {:.1} noise variances out of sample, below the {} the candidate space's false alarms ask",

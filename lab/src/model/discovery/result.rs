@@ -99,6 +99,12 @@ pub struct Discovery {
     /// fitted, and those proposed.
     pub terms: Vec<TermFound>,
     pub proposals: Proposals,
+    /// The mean of the residual after the model over the record, deg/h,
+    /// and its standard deviation from the stationary part of the noise
+    /// (centre.rs), and how far the model's constant was moved for it.
+    pub residual_mean_dph: f64,
+    pub residual_mean_sd_dph: f64,
+    pub centred_by_dph: f64,
 }
 
 /// Why an effect whose interval holds zero is carried, not named.

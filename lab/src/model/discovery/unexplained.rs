@@ -46,6 +46,25 @@ pub struct Unexplained {
     /// spikes left out of the fit.
     pub carried_by: Vec<String>,
     pub spikes: usize,
+    /// Set where a function of the inputs predicts it (trend.rs): the
+    /// function, in the term language.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input_function: Option<String>,
+    /// ... and that function fitted, for the proposal to offer.
+    #[serde(skip)]
+    pub input_term: Option<InputTerm>,
+}
+
+/// A function of the inputs fitted to what is left (trend.rs): the
+/// formula, its coefficients (deg/h per unit of the input's powers) with
+/// 95 % intervals under white noise, and its held-out gain in white-noise
+/// variances.
+#[derive(Clone, Debug)]
+pub struct InputTerm {
+    pub formula: String,
+    pub params: std::collections::BTreeMap<String, f64>,
+    pub intervals: std::collections::BTreeMap<String, (f64, f64)>,
+    pub held_out_gain: f64,
 }
 
 /// The unexplained part, one value per window, from its sources.
@@ -272,6 +291,8 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         correlates,
         carried_by,
         spikes: src.spikes.len(),
+        input_function: None,
+        input_term: None,
     })
 }
 
@@ -327,5 +348,7 @@ pub fn beyond_floor(
         correlates,
         carried_by: vec![why],
         spikes: 0,
+        input_function: None,
+        input_term: None,
     }
 }
