@@ -14,6 +14,13 @@ use gyro_coeffs::file::{read, Coeffs};
 use std::fmt::Write as _;
 use std::{env, fs, path::Path, path::PathBuf};
 
+/// A coefficient file the build cannot take: one line through cargo (no
+/// panic, no backtrace), and the build fails.
+fn refuse(msg: String) -> ! {
+    println!("cargo::error={}", msg.replace('\n', " "));
+    std::process::exit(0)
+}
+
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     fs::copy("memory.x", out.join("memory.x")).unwrap();
@@ -33,14 +40,14 @@ fn main() {
             .map(PathBuf::from)
             .unwrap_or_else(|| PathBuf::from(default));
         println!("cargo:rerun-if-changed={}", path.display());
-        let (_, c) = read(&path).unwrap_or_else(|e| panic!("{var}: {e}"));
+        let (_, c) = read(&path).unwrap_or_else(|e| refuse(format!("{var}: {e}")));
         let record = match (var, c) {
             ("RLG_COEFFS", Coeffs::RlgThermal(c)) => c.to_record().to_vec(),
             ("FOG_SF_COEFFS", Coeffs::FogScaleFactor(t)) => t.to_record().to_vec(),
-            _ => panic!(
+            _ => refuse(format!(
                 "{var}: {} holds the other kind of coefficients",
                 path.display()
-            ),
+            )),
         };
         fs::write(out.join(bin), record).unwrap();
     }

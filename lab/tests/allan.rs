@@ -402,7 +402,11 @@ fn json_files_and_a_self_contained_report() {
     assert!(html.contains("averaging time tau, s") && html.contains("Allan deviation, deg/h"));
     assert!(html.matches("<circle").count() >= n, "data points");
     assert!(html.contains("<polyline"), "fitted model");
-    assert!(html.contains("bias_instability_dph") && html.contains("absent"));
+    assert!(html.contains("bias instability") && html.contains("absent"));
+    assert!(
+        html.contains("In short: angle random walk"),
+        "the figures first"
+    );
 }
 
 #[test]

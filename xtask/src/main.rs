@@ -213,9 +213,38 @@ fn qemu_cmd() -> Result<()> {
     let report = frames::analyse(&run.frames_path)?;
     let dir = record_qemu_run(&run)?;
     frames::print_summary(&report);
+    print_coefficients();
     println!("run file: {}", dir.join("fog.csv").display());
     println!("RLG run file: {}", dir.join("rlg.csv").display());
     Ok(())
+}
+
+/// The coefficient files build.rs embedded (the same environment
+/// variables and defaults), each with its record's CRC: which calibration
+/// the run was made with.
+pub fn print_coefficients() {
+    for (var, default) in [
+        ("RLG_COEFFS", "config/rlg_thermal.toml"),
+        ("FOG_SF_COEFFS", "config/fog_scale_factor.toml"),
+    ] {
+        let (path, how) = match std::env::var_os(var) {
+            Some(p) => (PathBuf::from(p), "from the environment"),
+            None => (root().join(default), "the default"),
+        };
+        let crc = match gyro_coeffs::file::read(&path) {
+            Ok((_, gyro_coeffs::file::Coeffs::RlgThermal(c))) => {
+                gyro_coeffs::record::crc_of(&c.to_record())
+            }
+            Ok((_, gyro_coeffs::file::Coeffs::FogScaleFactor(t))) => {
+                gyro_coeffs::record::crc_of(&t.to_record())
+            }
+            Err(_) => 0,
+        };
+        println!(
+            "coefficients built in: {var} = {} ({how}), record CRC 0x{crc:08x}",
+            path.display()
+        );
+    }
 }
 
 /// The QEMU run's capture through the recorder into runs/qemu/, against
@@ -255,6 +284,7 @@ fn test_cmd() -> Result<()> {
     let qrun = run_qemu()?;
     let report = frames::analyse(&qrun.frames_path)?;
     frames::print_summary(&report);
+    print_coefficients();
     let checks = frames::qemu_checks(&report, &qrun.log);
     let failed = checks.iter().filter(|c| !c.1).count();
     for (name, ok, detail) in &checks {

@@ -13,7 +13,9 @@ use crate::noise::analysis::{analyse, Allan};
 use crate::noise::gaps::{fill_gaps, Filled};
 use crate::noise::model::Interval;
 use crate::noise::record_checks::{self, RecordWarning};
-use crate::noise::terms::{self, shape_name, COUNT, MARKOV_NAME, NAMES, SIN_NAME, SLOPES, UNITS};
+use crate::noise::terms::{
+    self, shape_name, COUNT, MARKOV_NAME, NAMES, PLAIN, SIN_NAME, SLOPES, UNITS,
+};
 use crate::report::document::Report;
 use crate::report::plot::Axes;
 use crate::report::text::{num, sig};
@@ -290,6 +292,60 @@ fn gaps_text(f: &Filled) -> String {
     parts.join("; ")
 }
 
+/// The figures a user looks for first, in words: the angle random walk
+/// and the bias instability (fitted, with their intervals, and as read off
+/// the curve), and any slower term the curve shows.
+fn headline(an: &Allan) -> String {
+    let t = &an.terms;
+    let term = |j: usize| -> String {
+        if t.present[j] {
+            format!(
+                "{} {} [{} .. {}] {}{}",
+                PLAIN[j],
+                num(terms::to_units(j, t.c[j])),
+                num(terms::to_units(j, t.lo[j])),
+                num(terms::to_units(j, t.hi[j])),
+                UNITS[j],
+                if t.reliable[j] { "" } else { " (unreliable)" }
+            )
+        } else {
+            format!("no {} (the curve shows no slope {})", PLAIN[j], SLOPES[j])
+        }
+    };
+    let r = &an.readings;
+    let n_read = r
+        .arw_dpsh
+        .map_or("no -1/2 region to read N from".into(), |n| {
+            format!("N = {} deg/sqrt(h) read at 1 s", num(n))
+        });
+    let b_read = if r.resolved {
+        format!(
+            "B = {} deg/h read off the floor",
+            num(r.bias_instability_dph)
+        )
+    } else {
+        format!(
+            "B <= {} deg/h (the floor is not resolved: an upper bound)",
+            num(r.bias_instability_dph)
+        )
+    };
+    let slow: Vec<String> = [0, 3, 4]
+        .into_iter()
+        .filter(|&j| t.present[j])
+        .map(term)
+        .collect();
+    format!(
+        "In short: {}; {}. Read off the curve: {n_read}; {b_read}.{}",
+        term(1),
+        term(2),
+        if slow.is_empty() {
+            " No quantization, rate random walk or rate ramp shows.".to_owned()
+        } else {
+            format!(" Also: {}.", slow.join("; "))
+        }
+    )
+}
+
 /// The verdict on the fit, one sentence.
 fn verdict(an: &Allan) -> String {
     let g = &an.terms.goodness;
@@ -385,9 +441,9 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
                 let bounded = j == 2 && t.bias_upper_bound;
                 row(
                     if bounded {
-                        "bias_instability_dph (upper bound: floor not resolved)"
+                        "bias instability (upper bound: floor not resolved)"
                     } else {
-                        NAMES[j]
+                        PLAIN[j]
                     },
                     SLOPES[j],
                     terms::to_units(j, t.c[j]),
@@ -398,7 +454,7 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
                 )
             } else {
                 vec![
-                    NAMES[j].into(),
+                    PLAIN[j].into(),
                     SLOPES[j].into(),
                     "absent".into(),
                     "-".into(),
@@ -444,7 +500,7 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
             ));
         }
         None => rows.push(vec![
-            SIN_NAME.into(),
+            "sinusoid".into(),
             "bump".into(),
             "absent".into(),
             "-".into(),
@@ -487,7 +543,7 @@ fn term_rows(an: &Allan) -> Vec<Vec<String>> {
             ));
         }
         None => rows.push(vec![
-            MARKOV_NAME.into(),
+            "correlated (Markov)".into(),
             "hump".into(),
             "absent".into(),
             "-".into(),
@@ -521,6 +577,7 @@ fn print_text(
         "mean rate {:.6e} +- {:.2e} deg/s (standard error from the noise model at the record length)",
         an.mean_dps, an.mean_se_dps
     );
+    println!("{}", headline(an));
     println!("{}", verdict(an));
     println!("IEEE 952 terms (95 % intervals; fitted to the whole curve; absent: the curve does not show it):");
     for r in term_rows(an) {
@@ -583,6 +640,7 @@ fn report(an: &Allan, name: &str, column: &str, warnings: &[RecordWarning]) -> R
         sig(an.taus[0]),
         sig(an.taus[an.taus.len() - 1])
     ));
+    r.paragraph(&headline(an));
     r.heading("Does the model fit?");
     r.paragraph(&verdict(an));
     r.heading("Allan deviation, the fitted noise terms and the readings");

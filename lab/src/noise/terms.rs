@@ -31,6 +31,14 @@ pub const NAMES: [&str; COUNT] = [
     "rate_random_walk",
     "rate_ramp",
 ];
+/// The power-law terms as a person names them.
+pub const PLAIN: [&str; COUNT] = [
+    "quantization",
+    "angle random walk",
+    "bias instability",
+    "rate random walk",
+    "rate ramp",
+];
 /// JSON names of the two other terms.
 pub const SIN_NAME: &str = "sinusoid";
 pub const MARKOV_NAME: &str = "correlated";

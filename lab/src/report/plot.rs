@@ -339,9 +339,14 @@ where
                     .legend(legend(c));
             }
             Style::Dashed => {
-                ch.draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(1)))?
+                ch.draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(2)))?
                     .label(s.label.as_str())
-                    .legend(legend(c));
+                    .legend(move |(x, y)| {
+                        // Dashed in the legend too: two dashes.
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (7, 0)], c.stroke_width(2))
+                            + PathElement::new(vec![(11, 0), (18, 0)], c.stroke_width(2))
+                    });
             }
             Style::Bands => {}
             Style::Points => {

@@ -71,7 +71,7 @@ pub struct DitherSummary {
     pub arw_predicted_dpsh: f64,
     /// The long-time walk where a dynamic lock-in zone holds the phase
     /// (the washboard's effective diffusion), deg/sqrt(h), and the zone's
-    /// relaxation time, s (null: no pull).
+    /// relaxation time, s (null: no pull, or one slower than 1e9 s).
     pub arw_long_time_predicted_dpsh: f64,
     pub zone_relaxation_s: Option<f64>,
     /// Killpatrick's `Omega_L/sqrt(2 pi K Omega_d)`, K in fringes per degree.
@@ -304,7 +304,10 @@ impl DitherRun {
             arw_hi_dpsh: term(t.hi[ARW]),
             arw_predicted_dpsh: dpsh(pred.arw_dps_rts),
             arw_long_time_predicted_dpsh: dpsh(pred.arw_long_dps_rts),
-            zone_relaxation_s: pred.relaxation_s.is_finite().then_some(pred.relaxation_s),
+            // A relaxation beyond any record (1e9 s, 30 years) is no pull:
+            // null, not 1e305.
+            zone_relaxation_s: (pred.relaxation_s.is_finite() && pred.relaxation_s < 1e9)
+                .then_some(pred.relaxation_s),
             arw_killpatrick_dpsh: dpsh(pred.killpatrick_dps_rts),
             arw_killpatrick_counts_k_dpsh: dpsh(killpatrick_counts),
             dither_residual_counts_rms: res_rms,

@@ -49,7 +49,7 @@ pub fn unresolved_terms(d: &ThermalData, c: &ThermalCoeffs, se: &ThermalCoeffs) 
             "dT^2 spans only {s} degC^2",
         ),
         (
-            "K4 (T_K)",
+            "K4 (case temperature T_K, degC)",
             c.k4_dph_per_c,
             se.k4_dph_per_c,
             span(&d.case),

@@ -246,7 +246,7 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "found": found,
         "gap_before_dph": d.gap_before_dph,
         "gap_after_dph": d.gap_after_dph,
-        "gap_window_s": gap_window_s(d),
+        "gap_window_s": report::gap_window_s(d),
         "residual_mean": {
             "value_dph": d.residual_mean_dph,
             "sd_dph": d.residual_mean_sd_dph,
@@ -377,7 +377,7 @@ pub fn run(a: &DiscoverArgs) -> Result<(), LabError> {
         }
         None => None,
     };
-    write_files(a, &d, &data)?;
+    write_files(a, &d, &data, &checked.warnings)?;
     if a.json.json {
         let mut j = json(&d);
         if let Some((p, v, terms)) = &validation {
@@ -531,7 +531,12 @@ fn run_extent(data: &Run) -> Extent {
 
 /// model.toml (the model with the effects found), residual.csv and the
 /// report, in `--out`.
-fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabError> {
+fn write_files(
+    a: &DiscoverArgs,
+    d: &Discovery,
+    data: &Run,
+    warnings: &[crate::record::Warning],
+) -> Result<(), LabError> {
     let out = &a.out.out;
     out_path::make(out)?;
     let mut names: Vec<&str> = d.found.iter().map(|e| e.effect.name()).collect();
@@ -568,7 +573,10 @@ fn write_files(a: &DiscoverArgs, d: &Discovery, data: &Run) -> Result<(), LabErr
         &d.residual_before,
         &d.residual_after,
     )?;
-    write_report(&report::report(d, data, &a.data), &out.join("report.html"))?;
+    write_report(
+        &report::report(d, data, &a.data, warnings),
+        &out.join("report.html"),
+    )?;
     Ok(())
 }
 
@@ -592,35 +600,12 @@ fn params_text(e: &Estimate) -> String {
         .join(", ")
 }
 
-/// What the gap's means are over: 1 s windows, or the rows themselves
-/// where they are further apart.
-pub fn gap_window_s(d: &Discovery) -> f64 {
-    let t = &d.windows.t;
-    let mut g: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    if g.is_empty() {
-        return WINDOW_S;
-    }
-    let k = g.len() / 2;
-    let med = *g.select_nth_unstable_by(k, f64::total_cmp).1;
-    med.max(WINDOW_S)
-}
-
-/// "1 s means", or "the rows (15 s each)" where the rows are longer.
-pub fn gap_means_text(d: &Discovery) -> String {
-    let w = gap_window_s(d);
-    if w > 1.5 * WINDOW_S {
-        format!("its rows ({} s each)", sig(w))
-    } else {
-        format!("{WINDOW_S} s means")
-    }
-}
-
 fn print_text(a: &DiscoverArgs, d: &Discovery) {
     let out = &a.out.out;
     println!(
         "{}: gap (RMS of {} of measured - model) {:.4} deg/h; noise floor there {:.4} deg/h",
         a.data.display(),
-        gap_means_text(d),
+        report::gap_means_text(d),
         d.gap_before_dph,
         d.noise_floor_dph
     );

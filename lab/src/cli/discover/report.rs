@@ -38,7 +38,7 @@ fn residual_section(r: &mut Report, d: &Discovery) {
     r.heading("Residual before and after");
     r.plot(
         &Axes {
-            title: "measured - model, 1 s means".into(),
+            title: format!("measured - model, {}", gap_means_text(d)),
             x_label: "time since power-on, s".into(),
             y_label: "residual, deg/h".into(),
             log_x: false,
@@ -126,8 +126,12 @@ fn params_cell(e: &Estimate) -> String {
 fn found_section(r: &mut Report, d: &Discovery) {
     r.heading("Effects found");
     if d.found.is_empty() {
+        let terms = d.terms.iter().any(|t| t.proposed && t.carried.is_none());
         r.paragraph(if d.unexplained.is_some() {
             "No effect of the library is named (what the residual holds is below, under \"Unexplained\")."
+        } else if terms {
+            "No effect of the library is named: a term outside the library explains what the residual held \
+             (below, under \"Terms outside the physics library\")."
         } else if d.ambiguous.is_empty() {
             "Nothing is missing: no effect of the library beats the noise, and nothing stands out of it."
         } else {
@@ -224,7 +228,13 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
                     sig(worst),
                     sig(100.0 * v.held_out_share)
                 ),
-                t.carried.clone().unwrap_or_else(|| "named".into()),
+                t.carried.clone().unwrap_or_else(|| {
+                    if t.proposed {
+                        "in the model written, as a proposal (not a library effect)".into()
+                    } else {
+                        "in the model written, fitted".into()
+                    }
+                }),
             ]],
         );
         if let Some(g) = &t.disguise {
@@ -283,9 +293,10 @@ fn unexplained_section(r: &mut Report, d: &Discovery) {
         return;
     };
     r.paragraph(&format!(
-        "No effect of the library explains this: {} deg/h (RMS of 1 s means) stays above the noise after the model, \
+        "No effect of the library explains this: {} deg/h (RMS of {}) stays above the noise after the model, \
          carried by {}.",
         num(u.excess_dph),
+        gap_means_text(d),
         u.carried_by.join("; ")
     ));
     if !u.spans.is_empty() {
@@ -360,7 +371,7 @@ fn effect_plots(r: &mut Report, d: &Discovery, run: &Run) {
                 log_y: false,
             },
             &[
-                Series::points("1 s means", pts, None, 0),
+                Series::points(&gap_means_text(d), pts, None, 0),
                 Series::line("fitted", vec![(lo * DPH, lo * DPH), (hi * DPH, hi * DPH)], 1),
             ],
             &format!(
@@ -466,13 +477,16 @@ fn verdict(d: &Discovery) -> Verdict {
             "a term outside the physics library is in the model written: it predicts the data, but it is not a named physical effect",
         );
     }
-    v.text(" The gap (RMS of 1 s means of measured - model) went from ")
-        .num("gap_before_dph", d.gap_before_dph, 4)
-        .text(" to ")
-        .num("gap_after_dph", d.gap_after_dph, 4)
-        .text(" deg/h against a noise floor of ")
-        .num("noise_floor_dph", d.noise_floor_dph, 4)
-        .text(" deg/h");
+    v.text(&format!(
+        " The gap (RMS of {} of measured - model) went from ",
+        gap_means_text(d)
+    ))
+    .num("gap_before_dph", d.gap_before_dph, 4)
+    .text(" to ")
+    .num("gap_after_dph", d.gap_after_dph, 4)
+    .text(" deg/h against a noise floor of ")
+    .num("noise_floor_dph", d.noise_floor_dph, 4)
+    .text(" deg/h");
     let excess = |g: f64| (g * g - d.noise_floor_dph.powi(2)).max(0.0);
     if excess(d.gap_before_dph) > 0.0 {
         let closed = 100.0 * (1.0 - excess(d.gap_after_dph) / excess(d.gap_before_dph));
@@ -535,17 +549,32 @@ fn verdict(d: &Discovery) -> Verdict {
     v
 }
 
-pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
+pub fn report(
+    d: &Discovery,
+    run: &Run,
+    data: &Path,
+    warnings: &[crate::record::Warning],
+) -> Report {
     let mut r = Report::new(&format!("What the model misses: {}", data.display()));
-    r.verdict(&verdict(d));
+    let mut v = verdict(d);
+    v.text(" The residual after the model averages ")
+        .num("residual_mean.value_dph", d.residual_mean_dph, 4)
+        .text(" deg/h over the record (standard deviation ")
+        .num("residual_mean.sd_dph", d.residual_mean_sd_dph, 4)
+        .text(" deg/h).");
+    for w in warnings {
+        v.warning(w.code, &w.message);
+    }
+    r.verdict(&v);
     r.paragraph(&format!(
-        "{} gyro, {} rows ({} s windows: {}). Gap (RMS of {WINDOW_S} s means of measured - model): {} deg/h \
+        "{} gyro, {} rows ({} s windows: {}). Gap (RMS of {} of measured - model): {} deg/h \
          before, {} deg/h after; noise floor there {} deg/h (what the residual's noise, its slow levels at \
          most the grade's, leaves in the gap).",
         d.gyro.name(),
         run.inputs.len(),
         WINDOW_S,
         d.windows.len(),
+        gap_means_text(d),
         num(d.gap_before_dph),
         num(d.gap_after_dph),
         num(d.noise_floor_dph)
@@ -558,4 +587,27 @@ pub fn report(d: &Discovery, run: &Run, data: &Path) -> Report {
     effect_plots(&mut r, d, run);
     ambiguous_and_skipped(&mut r, d);
     r
+}
+
+/// What the gap's means are over: 1 s windows, or the rows themselves
+/// where they are further apart.
+pub fn gap_window_s(d: &Discovery) -> f64 {
+    let t = &d.windows.t;
+    let mut g: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    if g.is_empty() {
+        return WINDOW_S;
+    }
+    let k = g.len() / 2;
+    let med = *g.select_nth_unstable_by(k, f64::total_cmp).1;
+    med.max(WINDOW_S)
+}
+
+/// "1 s means", or "the rows (15 s each)" where the rows are longer.
+pub fn gap_means_text(d: &Discovery) -> String {
+    let w = gap_window_s(d);
+    if w > 1.5 * WINDOW_S {
+        format!("its rows ({} s each)", sig(w))
+    } else {
+        format!("{WINDOW_S} s means")
+    }
 }

@@ -169,11 +169,20 @@ fn sf_plot(r: &mut Report, f: &SfFit, d: &SfDiagnostics, plateaus: Option<&[Plat
         ));
     }
     let n = f.table.n;
+    let nodes: Vec<(f64, f64)> = (0..n)
+        .map(|k| (f.table.temps_c[k], f.table.sf_ppm[k]))
+        .collect();
+    // The table lies within hundredths of a ppm of the model: its line is
+    // dashed over the model's, and its nodes are marked so it shows.
     s.push(Series::dashed(
-        &format!("firmware table ({n} nodes)"),
-        (0..n)
-            .map(|k| (f.table.temps_c[k], f.table.sf_ppm[k]))
-            .collect(),
+        "firmware table, linear between nodes",
+        nodes.clone(),
+        2,
+    ));
+    s.push(Series::points(
+        &format!("firmware table's {n} nodes"),
+        nodes,
+        None,
         2,
     ));
     if !f.knees.is_empty() {

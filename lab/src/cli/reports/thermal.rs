@@ -29,7 +29,7 @@ fn verdict(s: &FitSummary) -> Verdict {
     let se = s.std_100s_se_dph;
     v.text(
         "Fitted the RLG thermal bias model B = bias0 + K1 dT + K2 grad(dT) + K3 dT^2 + K4 T_K + \
-         K5 (1 - exp(-t/tau_warm)) on ",
+         K5 (1 - exp(-t/tau_warm)) (dT the monoblock sensors' difference, T_K the case sensor in degC) on ",
     )
     .count("rows", s.rows)
     .text(" rows over ")
@@ -68,7 +68,7 @@ fn coefficient_table(r: &mut Report, s: &FitSummary) {
         ("K1 (dT)", "deg/h per degC"),
         ("K2 (grad dT)", "deg/h per degC/s"),
         ("K3 (dT^2)", "deg/h per degC^2"),
-        ("K4 (T_K)", "deg/h per degC"),
+        ("K4 (case temperature T_K, degC)", "deg/h per degC"),
         ("K5 (warm-up)", "deg/h"),
         ("tau_warm", "s"),
     ];

@@ -204,6 +204,16 @@ fn print_summary(s: &DitherSummary) {
         s.residual_lock_in_dph,
         s.zone_kappa
     );
+    if let (Some(lo), Some(hi)) = (s.arw_lo_dpsh, s.arw_hi_dpsh) {
+        if !(lo..=hi).contains(&s.arw_predicted_dpsh) {
+            println!(
+                "note: the prediction lies outside the measured ARW's 95 % interval; the formula is Killpatrick's \
+                 approximation with the kicks' random part, which measured within 0.95 .. 1.07 of it over the 32 \
+                 corners of docs/notes/issue-33-dither.md: a {:.1} % difference here is the formula's, not the stripping's",
+                100.0 * (s.arw_dpsh.unwrap_or(f64::NAN) / s.arw_predicted_dpsh - 1.0)
+            );
+        }
+    }
     if s.flags_seen != 0 {
         println!("RLG flags seen: {:#04x}", s.flags_seen);
     }

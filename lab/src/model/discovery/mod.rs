@@ -419,6 +419,7 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     centre::centre(
         run,
         outside::beyond(model, run, opts, first, &discover_library),
+        WINDOW_S,
     )
 }
 
