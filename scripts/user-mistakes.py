@@ -463,8 +463,8 @@ def define_cases():
     case("out-file-for-dir-disc", "discover --out an existing run file, --force", mems + "hub.csv --out {o}/other_run.csv --force",
          fails("folder|directory|kind|file"), setup=copy_to("in/rest.csv", "{o}/other_run.csv"))
     case("out-mymodel", "discover --out mymodel.toml (a folder expected)", mems + "hub.csv --out {o}/mymodel.toml",
-         either(fails("folder|directory"), succeeds(("mymodel.toml is a gyro_model file", lambda j: 'kind = "gyro_model"' in open(
-             os.path.join(WORK, "out/out-mymodel/mymodel.toml")).read()))))
+         either(fails("folder|directory"), succeeds(("mymodel.toml is a gyro_model file", lambda j: os.path.isfile(os.path.join(WORK, "out/out-mymodel/mymodel.toml"))
+             and 'kind = "gyro_model"' in open(os.path.join(WORK, "out/out-mymodel/mymodel.toml")).read()))))
     case("out-kind-csv", "fit thermal --out a run file (not an input), --force",
          "fit thermal --data in/cycle.csv --out {o}/run.csv --force", fails("kind|run|csv|toml"),
          setup=copy_to("in/rest.csv", "{o}/run.csv"))

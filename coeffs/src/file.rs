@@ -150,9 +150,15 @@ pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
             ));
         }
         if lo < min || hi > max {
-            let kelvin = (lo - 273.15 >= min && hi - 273.15 <= max)
-                .then(|| format!(" ({:.1}..{:.1} degC if the fit read kelvin as degC: refit with --temp-unit K)", lo - 273.15, hi - 273.15))
-                .unwrap_or_default();
+            let kelvin = if lo - 273.15 >= min && hi - 273.15 <= max {
+                format!(
+                    " ({:.1}..{:.1} degC if the fit read kelvin as degC: refit with --temp-unit K)",
+                    lo - 273.15,
+                    hi - 273.15
+                )
+            } else {
+                String::new()
+            };
             return Err(format!(
                 "{name}: fitted over {lo:.1}..{hi:.1} degC ([range] temp_c), outside the {min}..+{max} degC the firmware's sensors read{kelvin}"
             ));
@@ -222,4 +228,35 @@ pub fn write(path: &Path, f: &CoeffFile, comment: &str) -> Result<(), String> {
         let _ = std::fs::remove_file(&tmp);
     }
     written.map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_range(lo: f64, hi: f64) -> String {
+        let dir = std::env::temp_dir().join(format!("gyro-coeffs-range-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(format!("c-{lo}-{hi}.toml"));
+        let mut f = CoeffFile::rlg_thermal(ThermalCoeffs::SAFE, toml::Table::new());
+        f.range = Some(FittedRange { temp_c: [lo, hi] });
+        write(&p, &f, "test").unwrap();
+        match read(&p) {
+            Ok(_) => String::new(),
+            Err(e) => e,
+        }
+    }
+
+    /// A set fitted on kelvin read as degC is refused, with the hint; one
+    /// inside the sensors' range is taken.
+    #[test]
+    fn a_set_fitted_outside_the_sensors_range_is_refused() {
+        assert_eq!(with_range(-40.0, 50.0), "");
+        let e = with_range(241.0, 330.0);
+        assert!(
+            e.contains("outside the -55..+150 degC") && e.contains("--temp-unit K"),
+            "{e}"
+        );
+        assert!(!with_range(-80.0, 20.0).is_empty());
+    }
 }

@@ -1,10 +1,10 @@
 //! `gyro-lab compensate --coeffs model.toml`: a model from `discover`
 //! applied to a run. The model's output is the reference rate plus its
 //! effects and terms; what it adds to the reference is the gyro's error
-//! it explains, and that is taken off the output (`rate_comp_dps = rate_dps
-//! - (model - ref_rate_dps)`). The firmware applies no such model: this
-//! is the lab's correction, for checking a model on another run or
-//! cleaning a record before a noise analysis.
+//! it explains, and that is taken off the output: the compensated rate is
+//! the output less (the model's output less the reference). The firmware
+//! applies no such model: this is the lab's correction, for checking a
+//! model on another run or cleaning a record before a noise analysis.
 
 use crate::cli::checks;
 use crate::cli::model_file::read_model_file;

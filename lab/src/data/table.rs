@@ -158,6 +158,9 @@ fn csv_reader<R: std::io::Read>(d: Dialect, r: R) -> csv::Reader<R> {
         .from_reader(r)
 }
 
+/// A file kind's rules, owned by the table that reads columns later.
+pub type OwnedRules = Box<dyn Fn(&str) -> ColumnRule + 'static>;
+
 /// A data file held as text cells, with the line number of every row.
 pub struct TextTable {
     pub path: PathBuf,
@@ -168,7 +171,7 @@ pub struct TextTable {
     comments: Vec<String>,
     dialect: Dialect,
     spec: ReadSpec,
-    rules: Option<Box<dyn Fn(&str) -> ColumnRule + 'static>>,
+    rules: Option<OwnedRules>,
     /// The time column's name, and its values once read (cut to the
     /// stretch asked for).
     time_name: Option<String>,
@@ -188,7 +191,7 @@ impl TextTable {
         path: &Path,
         spec: &ReadSpec,
         time: Option<&str>,
-        rules: Option<Box<dyn Fn(&str) -> ColumnRule + 'static>>,
+        rules: Option<OwnedRules>,
     ) -> Result<Self, LabError> {
         let bytes =
             std::fs::read(path).map_err(|e| LabError::input(path, format!("cannot read: {e}")))?;

@@ -80,7 +80,7 @@ fn mixed_units(s: f64, read_as: RateUnit, ref_as: RateUnit, tol: f64) -> Option<
 /// A factor in words (57.3, 1/57.3, 3600, 1/3600).
 pub fn factor_text(f: f64) -> String {
     if f >= 1.0 {
-        format!("{}", crate::report::text::sig(f))
+        crate::report::text::sig(f).to_string()
     } else {
         format!("1/{}", crate::report::text::sig(1.0 / f))
     }
@@ -162,8 +162,12 @@ pub struct Refusal(pub String);
 pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
     let read_as = c.given.unwrap_or_default();
     let mut out = UnitCheck::default();
-    // 2: the name.
-    if let Some(named) = rate_unit_of_name(c.name) {
+    // 2: the name (our own column name, kept from a template, says
+    // nothing the user chose).
+    let ours = crate::data::run_file::Column::ALL
+        .iter()
+        .any(|col| col.name() == c.name);
+    if let Some(named) = rate_unit_of_name(c.name).filter(|_| !ours) {
         if named != read_as {
             let f = named.to_dps() / read_as.to_dps();
             let msg = format!(

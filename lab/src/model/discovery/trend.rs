@@ -89,7 +89,7 @@ fn candidates(inp: &Inputs, win: &Windows) -> Vec<(String, String, Vec<Vec<f64>>
         let (lo, hi) = m.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
             (a.0.min(v), a.1.max(v))
         });
-        if !(hi - lo >= MIN_SPAN_C) {
+        if hi - lo < MIN_SPAN_C || hi.is_nan() || lo.is_nan() {
             continue;
         }
         let mean = m.iter().sum::<f64>() / m.len() as f64;
@@ -132,7 +132,7 @@ pub fn input_trend(
         return None;
     }
     let sd = white_sd(after);
-    if !(sd > 0.0) {
+    if sd.is_nan() || sd <= 0.0 {
         return None;
     }
     let kept = |x: &[f64]| -> Vec<f64> {
