@@ -454,6 +454,7 @@ fn bench_cmd() -> Result<()> {
             .args([
                 "simulate",
                 "run",
+                "--force",
                 "--profile",
                 "table",
                 "--dt-s",
@@ -472,7 +473,7 @@ fn bench_cmd() -> Result<()> {
         }
         let t0 = std::time::Instant::now();
         let out = Command::new(&lab)
-            .args(["discover", "--gyro", "fog", "--json", "--data"])
+            .args(["discover", "--gyro", "fog", "--json", "--force", "--data"])
             .arg(&run_file)
             .arg("--out")
             .arg(dir.join("discover-bench"))

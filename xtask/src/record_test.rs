@@ -448,7 +448,7 @@ pub fn run(
     // 3. The lab's analyses on the damaged record: board to lab, end to end.
     let fog = out.join("fog.csv");
     let allan = Command::new(&lab)
-        .args(["allan", "--json", "--data"])
+        .args(["allan", "--json", "--force", "--data"])
         .arg(&fog)
         .arg("--out")
         .arg(dir.join("allan"))
@@ -474,7 +474,7 @@ pub fn run(
         ),
     ));
     let disc = Command::new(&lab)
-        .args(["discover", "--gyro", "fog", "--json", "--data"])
+        .args(["discover", "--gyro", "fog", "--json", "--force", "--data"])
         .arg(&fog)
         .arg("--out")
         .arg(dir.join("discover"))
