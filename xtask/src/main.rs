@@ -1,6 +1,7 @@
 //! `cargo xtask qemu | test | bench`: developer entry points. Each first installs
 //! what it needs (thumbv7em target, qemu-system-arm, flip-link, defmt-print).
 
+mod bench_discover;
 mod capture;
 mod frames;
 mod panic_paths;
@@ -432,59 +433,7 @@ fn bench_cmd() -> Result<()> {
             .as_f64()
             .with_context(|| format!("no {k} from gyro-lab bench allan-speed"))
     };
-    // Discovery on a one-hour run at 10 Hz and a six-hour run at 1 Hz (a
-    // knee, a temperature slope and a bias hidden from the ideal model).
-    let dir = root().join("runs");
-    std::fs::create_dir_all(&dir)?;
-    let truth = dir.join("bench-truth.toml");
-    std::fs::write(
-        &truth,
-        "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n\
-         [[effect]]\nname = \"scale_factor_temperature\"\nppm_per_c = 1.5\n\
-         [[effect]]\nname = \"scale_factor_knee\"\nknee_c = 30.0\nslope_change_ppm_per_c = 4.0\n\
-         [[effect]]\nname = \"bias\"\nbias_dph = 0.2\n",
-    )?;
-    let mut discover_s = vec![];
-    for (name, dt, dur) in [
-        ("discover-1h-10hz.csv", "0.1", "3600"),
-        ("discover-6h-1hz.csv", "1", "21600"),
-    ] {
-        let run_file = dir.join(name);
-        let st = Command::new(&lab)
-            .args([
-                "simulate",
-                "run",
-                "--force",
-                "--profile",
-                "table",
-                "--dt-s",
-                dt,
-                "--duration-s",
-                dur,
-                "--model",
-            ])
-            .arg(&truth)
-            .arg("--out")
-            .arg(&run_file)
-            .stdout(Stdio::null())
-            .status()?;
-        if !st.success() {
-            bail!("gyro-lab simulate run failed");
-        }
-        let t0 = std::time::Instant::now();
-        let out = Command::new(&lab)
-            .args(["discover", "--gyro", "fog", "--json", "--force", "--data"])
-            .arg(&run_file)
-            .arg("--out")
-            .arg(dir.join("discover-bench"))
-            .output()?;
-        discover_s.push(t0.elapsed().as_secs_f64());
-        let text = String::from_utf8_lossy(&out.stdout);
-        let v: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or("{}"))?;
-        if v["found"].as_array().map_or(0, |f| f.len()) != 3 {
-            bail!("discover on {name} did not find the three hidden effects: {v}");
-        }
-    }
+    let discover = bench_discover::costs(&lab, &root().join("runs"))?;
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
         "fog_closure_instructions_max": grab("max")?,
@@ -503,12 +452,14 @@ fn bench_cmd() -> Result<()> {
         "allan_read_1e7_s": af("allan_read_1e7_s")?,
         "allan_reference_1e5_s": af("allan_reference_1e5_s")?,
         "allan_1e7_vs_reference_1e5": af("allan_1e7_vs_reference_1e5")?,
-        "discover_1h_10hz_s": (discover_s[0] * 1000.0).round() / 1000.0,
-        "discover_6h_1hz_s": (discover_s[1] * 1000.0).round() / 1000.0,
         "flash_bytes": flash,
         "ram_bytes": ram,
         "stack_bytes": stack,
     });
+    let mut j = j;
+    if let (Some(o), Some(d)) = (j.as_object_mut(), discover.as_object()) {
+        o.extend(d.clone());
+    }
     println!("{j}");
     Ok(())
 }

@@ -9,8 +9,8 @@ use std::path::Path;
 /// The columns of residual.csv (time is the run file's).
 pub const COLUMNS: [(&str, CellFormat); 3] = [
     (Column::Time.name(), CellFormat::Shortest),
-    ("residual_before_dps", CellFormat::Exp(9)),
-    ("residual_after_dps", CellFormat::Exp(9)),
+    ("residual_before_dps", CellFormat::Shortest),
+    ("residual_after_dps", CellFormat::Shortest),
 ];
 
 pub fn write(path: &Path, t: &[f64], before: &[f64], after: &[f64]) -> Result<(), LabError> {

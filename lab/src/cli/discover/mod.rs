@@ -292,6 +292,9 @@ pub fn json(d: &Discovery) -> serde_json::Value {
         "intervals_reliable": d.short.is_none(),
         "intervals_note": d.short,
         "windows": d.windows.len(),
+        "fit_window_s": crate::model::discovery::fit_window_s(
+            d.windows.t.last().copied().unwrap_or(0.0) - d.windows.t.first().copied().unwrap_or(0.0)
+        ),
         "gyro": d.gyro.name(),
         "grade": d.grade,
     })

@@ -32,7 +32,7 @@ fn thin(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
 
 /// The residual over time before and after, and where it disagrees.
 fn residual_section(r: &mut Report, d: &Discovery) {
-    let win = &d.windows;
+    let win = &d.gap_windows;
     let before = win.mean(&d.residual_before);
     let after = win.mean(&d.residual_after);
     r.heading("Residual before and after");
@@ -567,12 +567,14 @@ pub fn report(
     }
     r.verdict(&v);
     r.paragraph(&format!(
-        "{} gyro, {} rows ({} s windows: {}). Gap (RMS of {} of measured - model): {} deg/h \
+        "{} gyro, {} rows (the fit's windows of {} s: {}). Gap (RMS of {} of measured - model): {} deg/h \
          before, {} deg/h after; noise floor there {} deg/h (what the residual's noise, its slow levels at \
          most the grade's, leaves in the gap).",
         d.gyro.name(),
         run.inputs.len(),
-        WINDOW_S,
+        crate::report::text::sig(crate::model::discovery::fit_window_s(
+            run.inputs.t.last().copied().unwrap_or(0.0) - run.inputs.t.first().copied().unwrap_or(0.0)
+        )),
         d.windows.len(),
         gap_means_text(d),
         num(d.gap_before_dph),
@@ -592,7 +594,7 @@ pub fn report(
 /// What the gap's means are over: 1 s windows, or the rows themselves
 /// where they are further apart.
 pub fn gap_window_s(d: &Discovery) -> f64 {
-    let t = &d.windows.t;
+    let t = &d.gap_windows.t;
     let mut g: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     if g.is_empty() {
         return WINDOW_S;

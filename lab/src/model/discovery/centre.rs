@@ -32,7 +32,7 @@ fn shift(e: &mut Estimate, by: f64) {
 /// Centres `d`'s model on `run`: its residual after averages to zero
 /// (`window_s`: the gap's averaging).
 pub fn centre(run: &Run, mut d: Discovery, window_s: f64) -> Discovery {
-    let w = d.windows.mean(&d.residual_after);
+    let w = d.gap_windows.mean(&d.residual_after);
     if w.is_empty() {
         return d;
     }
@@ -85,10 +85,10 @@ pub fn centre(run: &Run, mut d: Discovery, window_s: f64) -> Discovery {
     };
     if moved {
         d.residual_after.iter_mut().for_each(|r| *r -= mean);
-        d.gap_after_dph = gap(&d.windows, &d.residual_after);
+        d.gap_after_dph = gap(&d.gap_windows, &d.residual_after);
         d.centred_by_dph = by;
     }
-    let after = d.windows.mean(&d.residual_after);
+    let after = d.gap_windows.mean(&d.residual_after);
     d.residual_mean_dph = after.iter().sum::<f64>() / after.len() as f64 * 3600.0;
     d.residual_mean_sd_dph = sd * 3600.0;
     d

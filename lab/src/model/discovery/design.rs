@@ -57,13 +57,73 @@ pub struct Design<'a> {
     /// [`OFF_GRID_CACHE_BYTES`], emptied when full).
     off_grid: RefCell<HashMap<(String, u64), Rc<Whitened>>>,
     off_grid_bytes: Cell<usize>,
+    /// Per window, what the knee's column needs (made on its first use):
+    /// see [`KneeSums`].
+    knee: RefCell<Option<Rc<KneeSums>>>,
+}
+
+/// The scale-factor knee's column, w (T - knee)+ averaged over each
+/// window, at any knee from sums made once: a window whose temperatures
+/// lie all above the knee averages to mean(w T) - knee mean(w), one all
+/// below to nothing, and only the few a knee falls inside are summed row by
+/// row. Each search step costs the windows, not the rows (a 10 Hz record
+/// costs what a 1 Hz one does).
+struct KneeSums {
+    w: Vec<f64>,
+    wt: Vec<f64>,
+    t_min: Vec<f64>,
+    t_max: Vec<f64>,
+    /// First row of each window, and one past the last window's.
+    start: Vec<usize>,
+}
+
+impl KneeSums {
+    fn new(inp: &Inputs, win: &Windows) -> Option<Self> {
+        let temp = inp.temp.as_ref()?;
+        let n = win.len();
+        let mut s = Self {
+            w: vec![0.0; n],
+            wt: vec![0.0; n],
+            t_min: vec![f64::INFINITY; n],
+            t_max: vec![f64::NEG_INFINITY; n],
+            start: vec![usize::MAX; n + 1],
+        };
+        for (row, &i) in win.idx.iter().enumerate() {
+            s.w[i] += inp.w[row];
+            s.wt[i] += inp.w[row] * temp[row];
+            s.t_min[i] = s.t_min[i].min(temp[row]);
+            s.t_max[i] = s.t_max[i].max(temp[row]);
+            s.start[i] = s.start[i].min(row);
+        }
+        s.start[n] = win.idx.len();
+        // Windows are contiguous runs of rows (time increases).
+        (0..n).all(|i| s.start[i] < s.start[i + 1]).then_some(s)
+    }
+
+    fn column(&self, inp: &Inputs, win: &Windows, knee: f64) -> Vec<f64> {
+        let temp = inp.temp.as_deref().unwrap_or(&[]);
+        (0..win.len())
+            .map(|i| {
+                let sum = if self.t_min[i] >= knee {
+                    self.wt[i] - knee * self.w[i]
+                } else if self.t_max[i] <= knee {
+                    0.0
+                } else {
+                    (self.start[i]..self.start[i + 1])
+                        .map(|r| inp.w[r] * (temp[r] - knee).max(0.0))
+                        .sum()
+                };
+                1e-6 * sum / win.count[i]
+            })
+            .collect()
+    }
 }
 
 /// Grid points whitened together.
 const WHITEN_TERMS: usize = 8;
 
 /// Memory the whitened columns off the grid may take.
-const OFF_GRID_CACHE_BYTES: usize = 128 << 20;
+const OFF_GRID_CACHE_BYTES: usize = 32 << 20;
 
 /// Bytes a term's whitened columns take.
 fn bytes_of(w: &Whitened) -> usize {
@@ -71,7 +131,7 @@ fn bytes_of(w: &Whitened) -> usize {
 }
 
 /// Memory the grid's whitened columns may take.
-const GRID_CACHE_BYTES: usize = 256 << 20;
+const GRID_CACHE_BYTES: usize = 96 << 20;
 
 /// Golden-section steps of a search: after the grid, the bracket shrinks
 /// to 0.618^20 (7e-5) of two grid steps; the local refinement after
@@ -136,6 +196,7 @@ impl<'a> Design<'a> {
             grid_bytes: Cell::new(0),
             off_grid: RefCell::new(HashMap::new()),
             off_grid_bytes: Cell::new(0),
+            knee: RefCell::new(None),
         };
         let mut kinds = vec![Kind::Constant];
         kinds.extend(
@@ -222,6 +283,12 @@ impl<'a> Design<'a> {
                     .collect()],
                 offset: None,
             },
+            Kind::Effect(Effect::ScaleFactorKnee) if self.knee_sums().is_some() => Raw {
+                cols: vec![self
+                    .knee_sums()
+                    .map_or_else(Vec::new, |k| k.column(self.inp, self.win, t.x))],
+                offset: None,
+            },
             Kind::Effect(e) => {
                 let b = e.basis(self.inp, t.x);
                 Raw {
@@ -230,6 +297,15 @@ impl<'a> Design<'a> {
                 }
             }
         }
+    }
+
+    /// The knee's sums, made on first use (None without a temperature).
+    fn knee_sums(&self) -> Option<Rc<KneeSums>> {
+        if self.knee.borrow().is_none() {
+            let k = KneeSums::new(self.inp, self.win).map(Rc::new);
+            *self.knee.borrow_mut() = k;
+        }
+        self.knee.borrow().clone()
     }
 
     fn whiten_raw(&self, raw: &Raw) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {

@@ -59,6 +59,53 @@ use windows::Windows;
 
 /// The gap's averaging, s.
 pub const WINDOW_S: f64 = 1.0;
+/// Most windows the fit works on: a longer record is fitted on windows of
+/// a whole number of seconds that keep it within this (12 h of 1 s
+/// windows), so the selection's cost and memory stop growing with the
+/// record; the gap and its floor stay those of 1 s means.
+pub const MAX_FIT_WINDOWS: f64 = 43_200.0;
+
+/// The fit's window for a record of `span` s: 1 s, or the whole seconds
+/// that keep it within [`MAX_FIT_WINDOWS`].
+pub fn fit_window_s(span: f64) -> f64 {
+    if span <= MAX_FIT_WINDOWS * WINDOW_S {
+        WINDOW_S
+    } else {
+        (span / MAX_FIT_WINDOWS).ceil() * WINDOW_S
+    }
+}
+
+/// The noise model of fit windows (`win`) at the gap's windows (`win1`):
+/// the white level scaled by the rows they hold (the slower levels are
+/// per second already), and which gap windows fall in kept fit windows.
+fn at_gap_windows(
+    noise: &NoiseModel,
+    win: &Windows,
+    win1: &Windows,
+    keep: &[bool],
+) -> (NoiseModel, Vec<bool>) {
+    let nominal = |w: &Windows| {
+        let mut c = w.count.clone();
+        let k = c.len() / 2;
+        c.get(k)
+            .copied()
+            .map_or(1.0, |_| *c.select_nth_unstable_by(k, f64::total_cmp).1)
+    };
+    let mut m = *noise;
+    m.white *= nominal(win) / nominal(win1).max(1e-9);
+    // Each gap window kept where the fit window holding its first row is.
+    let mut first = vec![usize::MAX; win1.len()];
+    for (row, &i) in win1.idx.iter().enumerate() {
+        if first[i] == usize::MAX {
+            first[i] = row;
+        }
+    }
+    let keep1 = first
+        .iter()
+        .map(|&row| win.idx.get(row).is_none_or(|&j| keep[j]))
+        .collect();
+    (m, keep1)
+}
 /// Smoothing of the disagreement search, s.
 pub const SMOOTH_S: f64 = 60.0;
 /// Most passes of the selection.
@@ -428,13 +475,18 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
 pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
     let inp = &run.inputs;
     let r = residual(model, run);
-    let win = Windows::new(&inp.t, WINDOW_S);
+    let win1 = Windows::new(&inp.t, WINDOW_S);
+    let span = inp.t.last().copied().unwrap_or(0.0) - inp.t.first().copied().unwrap_or(0.0);
+    let win = match fit_window_s(span) {
+        w if w > WINDOW_S => Windows::new(&inp.t, w),
+        _ => Windows::new(&inp.t, WINDOW_S),
+    };
     let rw = win.mean(&r);
     let allan_before = allan_of(&inp.t, &r);
-    let floor = noise_floor(&win, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
+    let floor = noise_floor(&win1, allan_before.as_ref(), &inp.t, &r, WINDOW_S);
     let grade = match opts.grade {
         Some(g) => GradeChoice::given(g),
-        None => GradeChoice::inferred(arw_of_floor(floor, window_spacing(&win))),
+        None => GradeChoice::inferred(arw_of_floor(floor, window_spacing(&win1))),
     };
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
     let (cands, skipped) = candidates(model.gyro, inp);
@@ -536,11 +588,11 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
             ));
         }
     }
-    let gap_before = gap(&win, &r);
+    let gap_before = gap(&win1, &r);
     let build = |w: &[(Term, Estimate, Option<String>)]| {
         let m = with(model, &w.iter().map(|x| &x.1).collect::<Vec<_>>());
         let ra = residual(&m, run);
-        let g = gap(&win, &ra);
+        let g = gap(&win1, &ra);
         (m, ra, g)
     };
     let (mut model_after, mut r_after, mut gap_after) = build(&written);
@@ -600,7 +652,7 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
                 format!("not named: {NOT_SIGNIFICANT}")
             }),
             None if e.effect != Effect::Bias => {
-                let (size, peak) = varying_dph(model, run, &r, &win, &e);
+                let (size, peak) = varying_dph(model, run, &r, &win1, &e);
                 (size < IMMATERIAL_OF_FLOOR * floor && peak < IMMATERIAL_PEAK_OF_FLOOR * floor)
                     .then(|| {
                     format!(
@@ -654,11 +706,13 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
     // noise model swallowed.
     let caps = grade.value.noise_caps();
     let keep = &d.wh.keep;
-    let (floor2, _) = expected_gap(&noise.capped(caps), &win, keep);
+    let (noise1, keep1) = at_gap_windows(&noise, &win, &win1, keep);
+    let (floor2, _) = expected_gap(&noise1.capped(caps), &win1, &keep1);
     let hi2 = std::iter::once(&noise)
         .chain(&bounds)
         .map(|m| {
-            let (m2, v2) = expected_gap(&m.capped(caps), &win, keep);
+            let (m1, _) = at_gap_windows(m, &win, &win1, keep);
+            let (m2, v2) = expected_gap(&m1.capped(caps), &win1, &keep1);
             m2 + 3.0 * v2.sqrt()
         })
         .fold(0.0, f64::max);
@@ -722,6 +776,7 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
         residual_before: r,
         residual_after: r_after,
         windows: win,
+        gap_windows: win1,
         model_after,
         allan_before,
         allan_after,

@@ -71,7 +71,10 @@ pub struct Discovery {
     pub skipped: Vec<Skipped>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
+    /// The fit's windows (1 s, or longer on a long record: mod.rs's
+    /// `fit_window_s`), and the gap's (1 s).
     pub windows: Windows,
+    pub gap_windows: Windows,
     pub gap_before_dph: f64,
     pub gap_after_dph: f64,
     /// The gap the noise alone leaves (noise_floor.rs's `expected_gap`,

@@ -165,11 +165,37 @@ pub fn curvature(t: &[f64], x: &[f64], half: f64) -> Vec<f64> {
     let reach = 2.0 * half;
     let (t0, t1) = (t[0], t[n - 1]);
     let edge = |k: usize| t[k] - t0 < reach || t1 - t[k] < reach;
+    // The local cubic at edge rows at least a second apart (and the last
+    // of each edge), linear between: a curvature over minutes is smooth on
+    // a second, and a 10 Hz record's edges cost what a 1 Hz one's do.
+    let mut at: Vec<usize> = vec![];
     for k in (0..n).filter(|&k| edge(k)) {
+        let last_of_edge = k + 1 == n || !edge(k + 1);
+        let first_of_edge = k == 0 || !edge(k - 1);
+        if first_of_edge || last_of_edge || at.last().is_none_or(|&a| t[k] - t[a] >= 1.0) {
+            at.push(k);
+        }
+    }
+    let value = |k: usize| {
         let lo = t.partition_point(|&v| v < t[k] - reach);
         let hi = t.partition_point(|&v| v <= t[k] + reach);
-        if let Some(v) = local_cubic_curvature(&t[lo..hi], &x[lo..hi], t[k], reach) {
+        local_cubic_curvature(&t[lo..hi], &x[lo..hi], t[k], reach)
+    };
+    let vals: Vec<Option<f64>> = at.iter().map(|&k| value(k)).collect();
+    for (j, &k) in at.iter().enumerate() {
+        if let Some(v) = vals[j] {
             c[k] = v;
+        }
+        // The rows up to the next computed one on the same edge.
+        if let (Some(&k2), Some(Some(v1)), Some(Some(v2))) =
+            (at.get(j + 1), vals.get(j), vals.get(j + 1))
+        {
+            if (k + 1..k2).all(edge) {
+                for m in k + 1..k2 {
+                    let f = (t[m] - t[k]) / (t[k2] - t[k]);
+                    c[m] = v1 + (v2 - v1) * f;
+                }
+            }
         }
     }
     c
