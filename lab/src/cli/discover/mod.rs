@@ -280,6 +280,8 @@ pub fn json(d: &Discovery) -> serde_json::Value {
                 "label": t.label, "formula": t.formula, "held_out_gain": t.held_out_gain,
             })).collect::<Vec<_>>(),
             "note": d.proposals.note,
+            "space_size": d.proposals.space,
+            "threshold": d.proposals.threshold,
         },
         "disagreements": d.disagreements,
         "noise": {

@@ -187,6 +187,18 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
         return;
     }
     r.heading("Terms outside the physics library");
+    if d.proposals.space > 0 {
+        r.paragraph(&format!(
+            "The candidates are composed from the run's own inputs (docs/discovery.md): the rate and |rate|, each \
+             temperature, its rates of change, its lag and the differences between sensors, the acceleration, and \
+             shapes of time; their squares and cubes, products of two, an input times a shape of time, and events \
+             searched in two parameters. {} candidate columns (every point of every search) were screened; a \
+             candidate must predict blocks of the record it was not fitted on by {} noise variances, a threshold \
+             that grows with the space (4 ln of its size), so that noise buys no term.",
+            d.proposals.space,
+            num(d.proposals.threshold)
+        ));
+    }
     let win = &d.windows;
     let after = win.mean(&d.residual_after);
     for t in &d.terms {

@@ -62,6 +62,15 @@ impl<'a> Rows<'a> {
     fn dps(&self, x: &[f64]) -> Vec<f64> {
         self.wh.whiten(&self.d.windows.mean(x))
     }
+    /// Window-level columns in deg/h, whitened many at a time.
+    fn windows_dph(&self, xs: &[&[f64]]) -> Vec<Vec<f64>> {
+        let s: Vec<Vec<f64>> = xs
+            .iter()
+            .map(|x| x.iter().map(|v| v / 3600.0).collect())
+            .collect();
+        let r: Vec<&[f64]> = s.iter().map(Vec::as_slice).collect();
+        self.wh.whiten_many(&r)
+    }
 }
 
 /// The whitened columns the discovery's fit carries: the constant, every
@@ -234,32 +243,6 @@ fn refit_users(
     (m, cur)
 }
 
-/// The label of a function of the inputs offered by trend.rs.
-pub const TREND_LABEL: &str =
-    "a trend a temperature explains, preferred to the slow noise that could carry it as well";
-
-/// Where no candidate predicts what is left against the noise model, but
-/// a function of the inputs predicts it against the white noise (trend.rs:
-/// the noise model took it as its own), that function is offered: the
-/// physical reading of what the inputs explain. It joins the model only
-/// where it closes the gap as any proposal must.
-fn trend_proposal(cur: &Discovery) -> Option<crate::model::proposal::Proposed> {
-    let it = cur.unexplained.as_ref()?.input_term.clone()?;
-    let term = Term::new(&it.formula, it.params.clone()).ok()?;
-    Some(crate::model::proposal::Proposed {
-        label: TREND_LABEL,
-        term,
-        intervals: it.intervals,
-        validation: Validation {
-            folds: crate::model::proposal::validation::FOLDS,
-            held_out_gain: it.held_out_gain,
-            fold_gains: vec![],
-            threshold: crate::model::proposal::validation::THRESHOLD,
-            held_out_share: f64::NAN,
-        },
-    })
-}
-
 /// Discovery with the terms beyond the library: `first` is the library's
 /// discovery on `given`.
 pub fn beyond(
@@ -300,11 +283,7 @@ pub fn beyond(
     // of the excess above the floor it closed.
     let mut closure: Vec<(f64, f64, f64)> = vec![];
     while cur.unexplained.is_some() && proposed.len() < MAX_PROPOSED {
-        let from_inputs = cur
-            .unexplained
-            .as_ref()
-            .is_some_and(|u| u.input_function.is_some());
-        if cur.gap_after_dph < MIN_GAP_OVER_FLOOR * cur.noise_floor_dph && !from_inputs {
+        if cur.gap_after_dph < MIN_GAP_OVER_FLOOR * cur.noise_floor_dph {
             log.note = Some(format!(
                 "the gap after the model, {:.4} deg/h, is less than {MIN_GAP_OVER_FLOOR} times the noise floor ({:.4} deg/h): what stands above the floor is too little to propose a term for",
                 cur.gap_after_dph, cur.noise_floor_dph
@@ -314,16 +293,17 @@ pub fn beyond(
         let rows = Rows::new(&cur);
         let y = rows.dps(&cur.residual_after);
         let fit = fit_columns(given, &cur, inp, &rows, None);
-        let p = propose(inp, &y, &fit, &|x| rows.dph(x));
+        let p = propose(inp, &y, &fit, &|x| rows.dph(x), &cur.windows, &|xs| {
+            rows.windows_dph(xs)
+        });
         log.tried = p.tried;
-        let Some(pr) = p
-            .proposed
-            .or_else(|| from_inputs.then(|| trend_proposal(&cur)).flatten())
-        else {
+        log.space = p.space;
+        log.threshold = p.threshold;
+        let Some(pr) = p.proposed else {
             log.note = Some(match log.tried.first() {
                 Some(b) => format!(
                     "no term built from the run's inputs predicts what is left on data it was not fitted on: the best, {} ({}), gains {:.1} noise variances out of sample, below the {} the candidate space's false alarms ask",
-                    b.label, b.formula, b.held_out_gain, crate::model::proposal::validation::THRESHOLD
+                    b.label, b.formula, b.held_out_gain, p.threshold
                 ),
                 None => "the run's inputs give no candidate term".into(),
             });
@@ -362,7 +342,7 @@ pub fn beyond(
             break;
         }
         closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
-        proposed.push((pr.label.to_string(), pr.intervals, pr.validation));
+        proposed.push((pr.label.clone(), pr.intervals, pr.validation));
         (m, cur) = (m2, next);
     }
     // Every term's final values, intervals and validation, beside the

@@ -142,4 +142,8 @@ pub struct TermFound {
 pub struct Proposals {
     pub tried: Vec<Tried>,
     pub note: Option<String>,
+    /// The candidate columns searched and the held-out gain they had to
+    /// pass (0 where no proposal was searched).
+    pub space: usize,
+    pub threshold: f64,
 }

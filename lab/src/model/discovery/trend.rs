@@ -10,7 +10,7 @@
 //! otherwise have carried it: whether the record can tell the two apart is
 //! said, not decided silently for the noise.
 
-use super::unexplained::{Correlate, InputTerm, Span, Unexplained};
+use super::unexplained::{Correlate, Span, Unexplained};
 use super::windows::Windows;
 use crate::data::run_file::Column;
 use crate::model::inputs::Inputs;
@@ -257,12 +257,6 @@ impl InputTrend {
             )],
             spikes: 0,
             input_function: Some(self.formula.clone()),
-            input_term: Some(InputTerm {
-                formula: self.formula.clone(),
-                params: self.params.clone(),
-                intervals: self.intervals.clone(),
-                held_out_gain: self.held_out_gain,
-            }),
         }
     }
 }

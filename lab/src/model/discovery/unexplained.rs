@@ -50,21 +50,6 @@ pub struct Unexplained {
     /// function, in the term language.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input_function: Option<String>,
-    /// ... and that function fitted, for the proposal to offer.
-    #[serde(skip)]
-    pub input_term: Option<InputTerm>,
-}
-
-/// A function of the inputs fitted to what is left (trend.rs): the
-/// formula, its coefficients (deg/h per unit of the input's powers) with
-/// 95 % intervals under white noise, and its held-out gain in white-noise
-/// variances.
-#[derive(Clone, Debug)]
-pub struct InputTerm {
-    pub formula: String,
-    pub params: std::collections::BTreeMap<String, f64>,
-    pub intervals: std::collections::BTreeMap<String, (f64, f64)>,
-    pub held_out_gain: f64,
 }
 
 /// The unexplained part, one value per window, from its sources.
@@ -292,7 +277,6 @@ pub fn assess(d: &Design, noise: &NoiseModel, src: &Sources) -> Option<Unexplain
         carried_by,
         spikes: src.spikes.len(),
         input_function: None,
-        input_term: None,
     })
 }
 
@@ -349,6 +333,5 @@ pub fn beyond_floor(
         carried_by: vec![why],
         spikes: 0,
         input_function: None,
-        input_term: None,
     }
 }

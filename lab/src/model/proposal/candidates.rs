@@ -1,19 +1,26 @@
-//! The candidate space of a proposal: terms built from the run's own
-//! inputs, each written in the model file's term language (model/term/) so
-//! the term proposed is evaluated exactly as it was validated.
+//! The candidate space of a proposal: a grammar, not a list (issue 39).
+//! A real gyro's missing effect is on nobody's list, but it is built from
+//! the run's own inputs, so the space is made of them:
 //!
-//! Small on purpose. Every candidate has one or two linear coefficients
-//! and at most one searched shape parameter, but one: the settling from a
-//! time searches its onset and its time constant, on coarse grids (the
-//! onsets the step and the ramp share, ten time constants), and counts as
-//! more complex than any one-parameter shape, so it is proposed only
-//! where it predicts clearly better. A term cannot fit noise by being
-//! flexible, and the validation's threshold (validation.rs) pays for the
-//! whole space at once. Physical terms come first (products and powers of
-//! the rate, |rate|, the temperatures, their filtered derivatives, the
-//! acceleration), then the one-off shapes (a step at a time, a sinusoid at
-//! a period, an exponential with a time constant, a ramp, a settling from
-//! a time).
+//! - **primitives** ([`Prim`]): the rate and |rate| (where the table
+//!   turns); each temperature less 20 degC, its filtered first and second
+//!   derivatives, and the temperature through a first-order lag whose time
+//!   constant is searched (the commonest missing effect of a measured gyro:
+//!   its sensor is not where the physics is); the acceleration and its
+//!   magnitude (where the run gives it); and time's shapes: hours since
+//!   power-on, exp(-t/tau), a step at a time, a sinusoid at a period;
+//! - **candidates** ([`Candidate`]): each input primitive, its square and
+//!   cube, the product of two, and an input primitive times a shape of
+//!   time; the time shapes alone; and the events searched in two
+//!   parameters (a settling from a time, a jump that relaxes). No
+//!   candidate searches more than two parameters.
+//!
+//! Each candidate is a formula of the model file's term language
+//! (model/term/), so what is proposed is evaluated exactly as written, and
+//! a recipe of its primitives, so the search can screen it on window
+//! means (screen.rs) at the cost of the windows, not the rows. The space's
+//! size sets the threshold a candidate's held-out gain must pass
+//! (validation.rs's `threshold`): a larger space buys noise more chances.
 
 use crate::data::run_file::Column;
 use crate::model::inputs::Inputs;
@@ -33,14 +40,65 @@ pub struct Searched {
     pub grid: Vec<f64>,
 }
 
-/// A candidate term: its parts (summed) and the parameters searched (none,
-/// one, or the settling's two, searched on every pair of their grids).
+/// What a primitive is, for its window-level value (screen.rs).
+#[derive(Clone, Debug, PartialEq)]
+pub enum PrimKind {
+    /// A function of the run's columns, its window means taken from the
+    /// rows (the lag's at each point of its grid).
+    Input,
+    /// Hours since power-on.
+    Hours,
+    /// exp(-t/tau).
+    Decay,
+    /// step(t - t0).
+    Step,
+    /// sin and cos at a period: two parts.
+    Periodic,
+}
+
+/// A primitive: its label, formula (naming its searched parameter, if
+/// any), and what it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prim {
+    pub label: String,
+    pub text: String,
+    pub kind: PrimKind,
+    pub searched: Option<Searched>,
+}
+
+impl Prim {
+    fn input(label: String, text: String) -> Self {
+        Self {
+            label,
+            text,
+            kind: PrimKind::Input,
+            searched: None,
+        }
+    }
+
+    fn is_input(&self) -> bool {
+        self.kind == PrimKind::Input
+    }
+}
+
+/// One factor of a recipe: a primitive to a power.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Factor {
+    pub prim: usize,
+    pub power: i32,
+}
+
+/// A candidate term: its parts (summed), the parameters searched (none,
+/// one, or two, searched on every pair of their grids), and, for the
+/// screening, the primitives it is the product of (empty for the events
+/// searched in two parameters, which are screened from their formula).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
     /// What a gyro engineer would call it.
-    pub label: &'static str,
+    pub label: String,
     pub parts: Vec<Part>,
     pub searched: Vec<Searched>,
+    pub recipe: Vec<Factor>,
 }
 
 impl Candidate {
@@ -60,6 +118,12 @@ impl Candidate {
         self.parts.len() + self.searched.len()
     }
 
+    /// How composed it is: its factors' powers summed (a primitive 1, a
+    /// square or a product 2), the simpler preferred among equals.
+    pub fn order(&self) -> i32 {
+        self.recipe.iter().map(|f| f.power).sum::<i32>().max(1)
+    }
+
     /// Every point of the search: one value per searched parameter, in
     /// their order (one empty point when nothing is searched).
     pub fn points(&self) -> Vec<Vec<f64>> {
@@ -74,17 +138,6 @@ impl Candidate {
                 })
                 .collect()
         })
-    }
-}
-
-fn one(label: &'static str, shape: String) -> Candidate {
-    Candidate {
-        label,
-        parts: vec![Part {
-            coef: "k_dph",
-            shape,
-        }],
-        searched: vec![],
     }
 }
 
@@ -106,6 +159,23 @@ pub const SETTLING_TAUS: usize = 10;
 /// shorten it).
 pub const SETTLING_TAU_MIN_S: f64 = 120.0;
 
+/// Time constants a temperature's lag is searched over: from two minutes
+/// to a quarter of the record, in this many steps.
+pub const LAG_TAUS: usize = 8;
+pub const LAG_TAU_MIN_S: f64 = 120.0;
+
+/// Onsets of a step or an event: anywhere but the record's first and last
+/// 5 % (there a step is a bias or nothing).
+const ONSETS: usize = 96;
+/// The coarser grids of a shape of time inside a product (the product's
+/// search costs the grid's points).
+const PRODUCT_ONSETS: usize = 48;
+const PRODUCT_PERIODS: usize = 40;
+const PRODUCT_DECAYS: usize = 20;
+
+/// Widths a pulse is searched over.
+const PULSE_WIDTHS: usize = 10;
+
 /// `n` values from `a` to `b`, evenly spaced in log.
 fn log_grid(a: f64, b: f64, n: usize) -> Vec<f64> {
     (0..n)
@@ -113,150 +183,361 @@ fn log_grid(a: f64, b: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The candidates a run's inputs can carry.
-pub fn candidates(inp: &Inputs) -> Vec<Candidate> {
+/// `n` onsets over the record from `t0` over `span`.
+fn onsets(t0: f64, span: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
+        .collect()
+}
+
+/// The primitives of a run's inputs: the input primitives first, then
+/// time's shapes (at their grids inside products).
+pub fn primitives(inp: &Inputs) -> Vec<Prim> {
     let w = Column::RefRate.name();
     let t = Column::Time.name();
-    let mut c = vec![];
-    let turns = moves(&inp.w);
-    if turns {
-        c.push(one("rate squared", format!("{w}^2")));
-        c.push(one("rate cubed", format!("{w}^3")));
-        c.push(one("rate times |rate|", format!("{w} * abs({w})")));
-        c.push(one("|rate|", format!("abs({w})")));
+    let mut p = vec![];
+    if moves(&inp.w) {
+        p.push(Prim::input("rate".into(), w.to_owned()));
+        p.push(Prim::input("|rate|".into(), format!("abs({w})")));
     }
-    if let Some(temp) = &inp.temp {
-        if moves(temp) {
-            let tc = Column::Temp.name();
-            c.push(one(
-                "bias quadratic in temperature",
-                format!("({tc} - 20)^2"),
+    let span = inp.t.last().copied().unwrap_or(0.0) - inp.t.first().copied().unwrap_or(0.0);
+    let mut temps: Vec<(&str, &str, &[f64])> = vec![];
+    if let Some(x) = &inp.temp {
+        temps.push((Column::Temp.name(), "temperature", x));
+    }
+    if let Some((a, b)) = &inp.mono {
+        temps.push((Column::MonoA.name(), "monoblock A", a));
+        temps.push((Column::MonoB.name(), "monoblock B", b));
+    }
+    if let Some(c) = &inp.case {
+        temps.push((Column::Case.name(), "case temperature", c));
+    }
+    let moving: Vec<(&str, &str)> = temps
+        .iter()
+        .filter(|(_, _, x)| moves(x))
+        .map(|(c, n, _)| (*c, *n))
+        .collect();
+    // The gradients between sensors: where the heat flows, a gyro's bias
+    // follows (the case less the monoblocks' mean, one sensor less
+    // another).
+    for (k, &(a, na)) in moving.iter().enumerate() {
+        for &(b, nb) in &moving[k + 1..] {
+            p.push(Prim::input(
+                format!("{na} less {nb}"),
+                format!("({a} - {b})"),
             ));
-            c.push(one("coil temperature's curvature", format!("d2dt2({tc})")));
-            if turns {
-                c.push(one(
-                    "scale factor quadratic in temperature",
-                    format!("{w} * ({tc} - 20)^2"),
-                ));
-                c.push(one(
-                    "scale factor following the temperature's rate",
-                    format!("{w} * ddt({tc})"),
-                ));
+            if span / 4.0 > 2.0 * LAG_TAU_MIN_S {
+                p.push(Prim {
+                    label: format!("{na} less {nb} through a lag"),
+                    text: format!("lag({a} - {b}, tau_s)"),
+                    kind: PrimKind::Input,
+                    searched: Some(Searched {
+                        name: "tau_s",
+                        grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
+                    }),
+                });
             }
         }
     }
-    if let (Some((a, b)), Some(case)) = (&inp.mono, &inp.case) {
-        if moves(a) && moves(b) && moves(case) {
-            let (ma, mb, cc) = (
-                Column::MonoA.name(),
-                Column::MonoB.name(),
-                Column::Case.name(),
-            );
-            c.push(one(
-                "case less the monoblocks' mean",
-                format!("({cc} - ({ma} + {mb}) / 2)"),
+    if let (Some(_), Some(_)) = (&inp.mono, &inp.case) {
+        let (a, b, c) = (
+            Column::MonoA.name(),
+            Column::MonoB.name(),
+            Column::Case.name(),
+        );
+        if moving.len() >= 3 {
+            p.push(Prim::input(
+                "case less the monoblocks' mean".into(),
+                format!("({c} - ({a} + {b}) / 2)"),
             ));
-            c.push(one("case temperature's rate", format!("ddt({cc})")));
+        }
+    }
+    for (col, name, _) in temps.into_iter().filter(|(_, _, x)| moves(x)) {
+        p.push(Prim::input(
+            format!("{name} less 20 degC"),
+            format!("({col} - 20)"),
+        ));
+        p.push(Prim::input(format!("{name}'s rate"), format!("ddt({col})")));
+        p.push(Prim::input(
+            format!("{name}'s curvature"),
+            format!("d2dt2({col})"),
+        ));
+        if span / 4.0 > 2.0 * LAG_TAU_MIN_S {
+            p.push(Prim {
+                label: format!("{name} through a lag"),
+                text: format!("(lag({col}, tau_s) - 20)"),
+                kind: PrimKind::Input,
+                searched: Some(Searched {
+                    name: "tau_s",
+                    grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
+                }),
+            });
         }
     }
     if !inp.acc_derived && moves(&inp.acc) {
-        c.push(one(
-            "|angular acceleration|",
-            format!("abs({})", Column::RefAcc.name()),
-        ));
+        let a = Column::RefAcc.name();
+        p.push(Prim::input("acceleration".into(), a.to_owned()));
+        p.push(Prim::input("|acceleration|".into(), format!("abs({a})")));
     }
-    let t0 = inp.t.first().copied().unwrap_or(0.0);
-    let t1 = inp.t.last().copied().unwrap_or(0.0);
-    let span = t1 - t0;
     if span > 0.0 {
-        // Time is since power-on, so a ramp or a settling written on one
-        // run reads the same on the next.
-        c.push(one("ageing ramp", format!("{t} / 3600")));
-        // Steps, and ramps that start at a time (an ageing that sets in, a
-        // drift after an event): anywhere but the record's first and last
-        // 5 % (there a step is a bias or nothing), on one grid of onsets.
-        let n = 96;
-        let onsets: Vec<f64> = (0..n)
-            .map(|k| t0 + span * (0.05 + 0.9 * k as f64 / (n - 1) as f64))
-            .collect();
-        for (label, shape) in [
-            ("step", format!("step({t} - t0_s)")),
-            (
-                "ramp from a time",
-                format!("({t} - t0_s) / 3600 * step({t} - t0_s)"),
-            ),
-        ] {
-            c.push(Candidate {
-                label,
-                parts: vec![Part {
-                    coef: "k_dph",
-                    shape,
-                }],
-                searched: vec![Searched {
-                    name: "t0_s",
-                    grid: onsets.clone(),
-                }],
-            });
-        }
-        // Sinusoids: two or more periods in the record, down to 5 min.
+        let t0 = inp.t.first().copied().unwrap_or(0.0);
+        p.push(Prim {
+            label: "hours since power-on".into(),
+            text: format!("{t} / 3600"),
+            kind: PrimKind::Hours,
+            searched: None,
+        });
+        p.push(Prim {
+            label: "a decay".into(),
+            text: format!("exp(-{t} / tau_s)"),
+            kind: PrimKind::Decay,
+            searched: Some(Searched {
+                name: "tau_s",
+                grid: log_grid(60.0, span, PRODUCT_DECAYS),
+            }),
+        });
+        p.push(Prim {
+            label: "a step".into(),
+            text: format!("step({t} - t0_s)"),
+            kind: PrimKind::Step,
+            searched: Some(Searched {
+                name: "t0_s",
+                grid: onsets(t0, span, PRODUCT_ONSETS),
+            }),
+        });
         if span >= 600.0 {
-            c.push(Candidate {
-                label: "periodic disturbance",
-                parts: vec![
-                    Part {
-                        coef: "a_dph",
-                        shape: format!("sin(2 * pi * {t} / p_s)"),
-                    },
-                    Part {
-                        coef: "b_dph",
-                        shape: format!("cos(2 * pi * {t} / p_s)"),
-                    },
-                ],
-                searched: vec![Searched {
+            p.push(Prim {
+                label: "a period".into(),
+                text: format!("2 * pi * {t} / p_s"),
+                kind: PrimKind::Periodic,
+                searched: Some(Searched {
                     name: "p_s",
-                    grid: log_grid(300.0, span / 2.0, 80),
-                }],
+                    grid: log_grid(300.0, span / 2.0, PRODUCT_PERIODS),
+                }),
             });
         }
+    }
+    p
+}
+
+/// A candidate of one part from a recipe.
+fn product(prims: &[Prim], recipe: Vec<Factor>) -> Candidate {
+    let mut searched: Vec<Searched> = recipe
+        .iter()
+        .filter_map(|f| prims[f.prim].searched.clone())
+        .collect();
+    let periodic = recipe
+        .iter()
+        .find(|f| prims[f.prim].kind == PrimKind::Periodic)
+        .copied();
+    let others: Vec<String> = recipe
+        .iter()
+        .filter(|f| prims[f.prim].kind != PrimKind::Periodic)
+        .map(|f| match f.power {
+            1 => prims[f.prim].text.clone(),
+            k => format!("{}^{k}", prims[f.prim].text),
+        })
+        .collect();
+    let label = recipe
+        .iter()
+        .map(|f| match f.power {
+            1 => prims[f.prim].label.clone(),
+            2 => format!("{} squared", prims[f.prim].label),
+            _ => format!("{} cubed", prims[f.prim].label),
+        })
+        .collect::<Vec<_>>()
+        .join(" times ");
+    let parts = match periodic {
+        Some(f) => {
+            let arg = &prims[f.prim].text;
+            let with = |s: String| {
+                if others.is_empty() {
+                    s
+                } else {
+                    format!("{} * {s}", others.join(" * "))
+                }
+            };
+            vec![
+                Part {
+                    coef: "a_dph",
+                    shape: with(format!("sin({arg})")),
+                },
+                Part {
+                    coef: "b_dph",
+                    shape: with(format!("cos({arg})")),
+                },
+            ]
+        }
+        None => vec![Part {
+            coef: "k_dph",
+            shape: others.join(" * "),
+        }],
+    };
+    searched.dedup_by(|a, b| a.name == b.name);
+    Candidate {
+        label,
+        parts,
+        searched,
+        recipe,
+    }
+}
+
+/// The candidates a run's inputs can carry, with the primitives their
+/// recipes name.
+pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
+    let mut prims = primitives(inp);
+    let inputs: Vec<usize> = (0..prims.len()).filter(|&i| prims[i].is_input()).collect();
+    let shapes: Vec<usize> = (0..prims.len()).filter(|&i| !prims[i].is_input()).collect();
+    let f = |prim: usize, power: i32| Factor { prim, power };
+    let mut c = vec![];
+    for &i in &inputs {
+        c.push(product(&prims, vec![f(i, 1)]));
+        // |rate|^2 is rate^2.
+        if prims[i].label != "|rate|" && prims[i].label != "|acceleration|" {
+            c.push(product(&prims, vec![f(i, 2)]));
+            c.push(product(&prims, vec![f(i, 3)]));
+        }
+    }
+    for (a, &i) in inputs.iter().enumerate() {
+        for &j in &inputs[a + 1..] {
+            // One lag per candidate (its time constant is one parameter).
+            if prims[i].searched.is_some() && prims[j].searched.is_some() {
+                continue;
+            }
+            // Products of two of the primitives and their powers, to a
+            // degree of three: x y, x^2 y, x y^2.
+            for (pi, pj) in [(1, 1), (2, 1), (1, 2)] {
+                // |x|^2 is x^2: left to x's own products.
+                let even_abs = |k: usize, p: i32| p == 2 && prims[k].text.starts_with("abs(");
+                if !even_abs(i, pi) && !even_abs(j, pj) {
+                    c.push(product(&prims, vec![f(i, pi), f(j, pj)]));
+                }
+            }
+        }
+    }
+    // An input times a shape of time (a lag's and a shape's grids
+    // together would be hundreds of points: left out). A coefficient
+    // that ages or settles (hours, a decay) may be any input's; one that
+    // steps or oscillates, the rate's and the acceleration's (a scale
+    // factor that jumps at a mode hop, a table's periodic error): a
+    // temperature is itself slow in time, and its product with a step
+    // imitates the events of time alone.
+    for &i in inputs.iter().filter(|&&i| prims[i].searched.is_none()) {
+        let fast = prims[i].text.contains(Column::RefRate.name())
+            || prims[i].text.contains(Column::RefAcc.name());
+        for &s in &shapes {
+            let slow_shape = matches!(prims[s].kind, PrimKind::Hours | PrimKind::Decay);
+            if slow_shape || fast {
+                c.push(product(&prims, vec![f(i, 1), f(s, 1)]));
+            }
+        }
+    }
+    // The shapes of time alone, on their full grids.
+    let t = Column::Time.name();
+    let span = inp.t.last().copied().unwrap_or(0.0) - inp.t.first().copied().unwrap_or(0.0);
+    let t0 = inp.t.first().copied().unwrap_or(0.0);
+    for &s in &shapes {
+        let mut p = prims[s].clone();
+        if let Some(g) = p.searched.as_mut() {
+            g.grid = match p.kind {
+                PrimKind::Decay => log_grid(60.0, span, 40),
+                PrimKind::Step => onsets(t0, span, ONSETS),
+                PrimKind::Periodic => log_grid(300.0, span / 2.0, 80),
+                _ => g.grid.clone(),
+            };
+        }
+        prims.push(p);
+        let k = prims.len() - 1;
+        let mut cand = product(&prims, vec![f(k, 1)]);
+        cand.label = match prims[k].kind {
+            PrimKind::Hours => "ageing ramp".into(),
+            PrimKind::Decay => "exponential settling".into(),
+            PrimKind::Step => "step".into(),
+            _ => "periodic disturbance".into(),
+        };
+        c.push(cand);
+    }
+    if span > 0.0 {
+        let on = onsets(t0, span, ONSETS);
         c.push(Candidate {
-            label: "exponential settling",
+            label: "ramp from a time".into(),
             parts: vec![Part {
                 coef: "k_dph",
-                shape: format!("exp(-{t} / tau_s)"),
+                shape: format!("({t} - t0_s) / 3600 * step({t} - t0_s)"),
             }],
             searched: vec![Searched {
-                name: "tau_s",
-                grid: log_grid(60.0, span, 40),
+                name: "t0_s",
+                grid: on.clone(),
             }],
+            recipe: vec![],
         });
-        // A settling from a time (a bias that settles after an event: a
-        // mode hop, a relock, a heater switched), first order: 0 before
-        // t1, k (1 - exp(-(t - t1) / tau)) after. The step and the ramp
-        // from a time are its limits (tau -> 0, tau -> infinity). The
-        // step inside the exponential keeps its argument at or below zero
-        // (no overflow before t1). Onsets on the steps' grid, time
-        // constants from 2 min to a third of the record: 96 x 10 points,
-        // each judged as every candidate is (refined afterwards, both
-        // parameters jointly, by refit.rs).
+        // Events searched in two parameters: a bias that settles after an
+        // event (a mode hop, a relock, a heater switched: 0 before t1, k (1
+        // - exp(-(t - t1)/tau)) after), and a jump that relaxes (k from t0,
+        // decaying with tau). The step inside the exponential keeps its
+        // argument at or below zero (no overflow before the onset).
+        // A pulse: on at t0 for a width (a heater switched on and off, a
+        // vehicle's engine run), widths from a minute to half the record.
+        c.push(Candidate {
+            label: "a pulse".into(),
+            parts: vec![Part {
+                coef: "k_dph",
+                shape: format!("(step({t} - t0_s) - step({t} - t0_s - w_s))"),
+            }],
+            searched: vec![
+                Searched {
+                    name: "t0_s",
+                    grid: on.clone(),
+                },
+                Searched {
+                    name: "w_s",
+                    grid: log_grid(60.0, span / 2.0, PULSE_WIDTHS),
+                },
+            ],
+            recipe: vec![],
+        });
         if span / 3.0 > 2.0 * SETTLING_TAU_MIN_S {
-            c.push(Candidate {
-                label: "settling from a time",
-                parts: vec![Part {
-                    coef: "k_dph",
-                    shape: format!("(1 - exp(-({t} - t1_s) * step({t} - t1_s) / tau_s))"),
-                }],
-                searched: vec![
-                    Searched {
-                        name: "t1_s",
-                        grid: onsets.clone(),
-                    },
-                    Searched {
-                        name: "tau_s",
-                        grid: log_grid(SETTLING_TAU_MIN_S, span / 3.0, SETTLING_TAUS),
-                    },
-                ],
-            });
+            let taus = log_grid(SETTLING_TAU_MIN_S, span / 3.0, SETTLING_TAUS);
+            for (label, shape, onset) in [
+                (
+                    "settling from a time",
+                    format!("(1 - exp(-({t} - t1_s) * step({t} - t1_s) / tau_s))"),
+                    "t1_s",
+                ),
+                (
+                    "a jump that relaxes",
+                    format!("step({t} - t0_s) * exp(-({t} - t0_s) * step({t} - t0_s) / tau_s)"),
+                    "t0_s",
+                ),
+            ] {
+                c.push(Candidate {
+                    label: label.into(),
+                    parts: vec![Part {
+                        coef: "k_dph",
+                        shape,
+                    }],
+                    searched: vec![
+                        Searched {
+                            name: onset,
+                            grid: on.clone(),
+                        },
+                        Searched {
+                            name: "tau_s",
+                            grid: taus.clone(),
+                        },
+                    ],
+                    recipe: vec![],
+                });
+            }
         }
     }
-    c
+    (prims, c)
+}
+
+/// The number of candidate columns a run's space holds: every point of
+/// every candidate's grid (what the threshold pays for).
+pub fn space_size(c: &[Candidate]) -> usize {
+    c.iter()
+        .map(|c| c.searched.iter().map(|s| s.grid.len()).product::<usize>())
+        .sum()
 }

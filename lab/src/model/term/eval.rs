@@ -89,7 +89,7 @@ pub fn names(n: &Node) -> Vec<(String, Range<usize>)> {
             Expr::Num(_) => {}
             Expr::Name(s) => out.push((s.clone(), n.span.clone())),
             Expr::Neg(x) | Expr::Call(_, x) => go(x, out),
-            Expr::Bin(_, l, r) => {
+            Expr::Bin(_, l, r) | Expr::Lag(l, r) => {
                 go(l, out);
                 go(r, out);
             }
@@ -164,6 +164,23 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
                 }
             }
         }
+        Expr::Lag(x, tau) => {
+            let a = eval(x, env, at)?;
+            let tau = match eval(tau, env, at)? {
+                Val::All(v) if v > 0.0 && v.is_finite() => v,
+                _ => {
+                    return Err(EvalError {
+                        span: tau.span.clone(),
+                        msg: "a lag's time constant is a positive number of seconds".into(),
+                    })
+                }
+            };
+            let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
+            match a {
+                Val::All(v) => Val::All(v),
+                Val::Row(r) => Val::Row(lag(t, &r, tau)),
+            }
+        }
         Expr::Call(f, x) => {
             let a = eval(x, env, at)?;
             match f {
@@ -178,6 +195,8 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
                     v
                 }
                 Func::Step => a.map(|v| if v >= 0.0 { 1.0 } else { 0.0 }),
+                // Parsed as Expr::Lag (two arguments); never one.
+                Func::Lag => return Err(err("lag takes two arguments: lag(x, tau)".into())),
                 Func::Ddt | Func::D2dt2 => {
                     let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
                     let row = match a {
@@ -194,6 +213,33 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
             }
         }
     })
+}
+
+/// `x` through a first-order lag of time constant `tau` s over times
+/// `t`, from `x`'s first value: exact for `x` linear between rows (the
+/// lag of a ramp is the ramp less tau, reached after a few tau).
+pub fn lag(t: &[f64], x: &[f64], tau: f64) -> Vec<f64> {
+    let mut y = Vec::with_capacity(x.len());
+    let mut prev: Option<(f64, f64, f64)> = None;
+    for (&tk, &xk) in t.iter().zip(x) {
+        let yk = match prev {
+            None => xk,
+            Some((t0, x0, y0)) => {
+                let h = ((tk - t0) / tau).max(0.0);
+                let e = (-h).exp();
+                // (1 - e^-h)/h, its limit 1 at h = 0.
+                let g = if h < 1e-8 {
+                    1.0 - 0.5 * h
+                } else {
+                    (1.0 - e) / h
+                };
+                xk - (xk - x0) * g + (y0 - x0) * e
+            }
+        };
+        y.push(yk);
+        prev = Some((tk, xk, yk));
+    }
+    y
 }
 
 /// x^y, exact for small whole exponents (x^2 is x*x, as the formula says).

@@ -8,12 +8,13 @@
 //! product = unary (("*" | "/") unary)*
 //! unary   = "-" unary | power
 //! power   = atom ("^" unary)?            (right-associative: 2^3^2 = 2^9)
-//! atom    = number | name | name "(" expr ")" | "(" expr ")"
+//! atom    = number | name | name "(" expr ")" | "lag" "(" expr "," expr ")" | "(" expr ")"
 //! ```
 //!
 //! `-x^2` is `-(x^2)`, as in mathematics; a name followed by `(` is a
-//! function (`abs sin cos exp step ddt d2dt2`), any other name a column of
-//! the run, a parameter, or `pi`.
+//! function (`abs sin cos exp step ddt d2dt2`, and `lag(x, tau)`: `x`
+//! through a first-order lag of time constant `tau` s), any other name a
+//! column of the run, a parameter, or `pi`.
 
 use std::ops::Range;
 
@@ -30,10 +31,12 @@ pub enum Func {
     Ddt,
     /// The tool's filtered second derivative in time.
     D2dt2,
+    /// A first-order lag in time: `lag(x, tau)`, two arguments.
+    Lag,
 }
 
 impl Func {
-    pub const ALL: [Func; 7] = [
+    pub const ALL: [Func; 8] = [
         Func::Abs,
         Func::Sin,
         Func::Cos,
@@ -41,6 +44,7 @@ impl Func {
         Func::Step,
         Func::Ddt,
         Func::D2dt2,
+        Func::Lag,
     ];
 
     pub fn name(self) -> &'static str {
@@ -52,6 +56,7 @@ impl Func {
             Func::Step => "step",
             Func::Ddt => "ddt",
             Func::D2dt2 => "d2dt2",
+            Func::Lag => "lag",
         }
     }
 
@@ -101,6 +106,8 @@ pub enum Expr {
     Neg(Box<Node>),
     Bin(Op, Box<Node>, Box<Node>),
     Call(Func, Box<Node>),
+    /// `lag(x, tau)`.
+    Lag(Box<Node>, Box<Node>),
 }
 
 /// A node and the byte span of its text in the formula.
@@ -164,7 +171,7 @@ fn tokens(s: &str) -> Result<Vec<(Tok, Range<usize>)>, ParseError> {
                 i += 1;
             }
             out.push((Tok::Name(s[start..i].to_string()), start..i));
-        } else if b"+-*/^()".contains(&c) {
+        } else if b"+-*/^(),".contains(&c) {
             out.push((Tok::Sym(c as char), i..i + 1));
             i += 1;
         } else {
@@ -318,13 +325,25 @@ impl Parser<'_> {
                 };
                 self.at += 1;
                 let arg = self.sum()?;
+                let second = if f == Func::Lag {
+                    if !self.is_sym(',') {
+                        return Err(self.expected("`,` and the lag's time constant (lag(x, tau))"));
+                    }
+                    self.at += 1;
+                    Some(self.sum()?)
+                } else {
+                    None
+                };
                 if !self.is_sym(')') {
                     return Err(self.expected("`)`"));
                 }
                 let end = self.toks[self.at].1.end;
                 self.at += 1;
                 Ok(Node {
-                    expr: Expr::Call(f, Box::new(arg)),
+                    expr: match second {
+                        Some(tau) => Expr::Lag(Box::new(arg), Box::new(tau)),
+                        None => Expr::Call(f, Box::new(arg)),
+                    },
                     span: span.start..end,
                 })
             }
@@ -401,6 +420,13 @@ pub fn to_text(n: &Node) -> String {
                 out.push_str(f.name());
                 out.push('(');
                 go(x, out, 0, None);
+                out.push(')');
+            }
+            Expr::Lag(x, tau) => {
+                out.push_str("lag(");
+                go(x, out, 0, None);
+                out.push_str(", ");
+                go(tau, out, 0, None);
                 out.push(')');
             }
             Expr::Bin(op, l, r) => {
