@@ -117,12 +117,25 @@ impl CoeffFile {
     }
 }
 
+/// A coefficient file's text, `comment` as `#` lines before it.
+pub fn to_text(f: &CoeffFile, comment: &str) -> Result<String, String> {
+    let body = toml::to_string(f).map_err(|e| e.to_string())?;
+    let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
+    Ok(format!("{head}{body}"))
+}
+
 /// Reads and checks a coefficient file; errors are one line,
 /// `file:line:column: message` where the parser knows the place. The
 /// values are checked as the firmware checks its record.
 pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
-    let name = path.display();
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    parse(&text, &path.display().to_string())
+}
+
+/// [`read`] of a coefficient file's text; `name` (a path, or what the
+/// caller calls the text) starts its errors.
+pub fn parse(text: &str, name: &str) -> Result<(CoeffFile, Coeffs), String> {
     let f: CoeffFile = toml::from_str(&text).map_err(|e| {
         let msg = e.message().replace('\n', " ");
         match e.span() {
@@ -211,8 +224,7 @@ pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
 /// leaves the old file whole).
 pub fn write(path: &Path, f: &CoeffFile, comment: &str) -> Result<(), String> {
     use std::io::Write;
-    let body = toml::to_string(f).map_err(|e| e.to_string())?;
-    let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
+    let text = to_text(f, comment)?;
     let err = |e: std::io::Error| format!("{}: {e}", path.display());
     let name = path
         .file_name()
@@ -220,7 +232,7 @@ pub fn write(path: &Path, f: &CoeffFile, comment: &str) -> Result<(), String> {
     let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
     let written = (|| {
         let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(format!("{head}{body}").as_bytes())?;
+        file.write_all(text.as_bytes())?;
         file.sync_all()?;
         std::fs::rename(&tmp, path)
     })();

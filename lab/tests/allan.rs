@@ -8,11 +8,11 @@
 mod common;
 use common::{lab, lab_ok};
 
-use gyro_lab::bench::allan::{judge, truth_present, SAMPLES, SCENARIOS, SHORT, TAU0_S};
-use gyro_lab::noise::analysis::{analyse, Allan};
-use gyro_lab::noise::terms;
-use gyro_lab::sim::independent_noise;
-use gyro_lab::sim::noise_run::{record, record_with, Truth};
+use gyro_lab_core::bench::allan::{judge, truth_present, SAMPLES, SCENARIOS, SHORT, TAU0_S};
+use gyro_lab_core::noise::analysis::{analyse, Allan};
+use gyro_lab_core::noise::terms;
+use gyro_lab_core::sim::independent_noise;
+use gyro_lab_core::sim::noise_run::{record, record_with, Truth};
 
 #[test]
 fn known_terms_recovered_and_absent_ones_not_reported() {

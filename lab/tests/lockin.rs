@@ -2,9 +2,9 @@
 //! estimator (closed-form periodic solution) against the simulator (numerical
 //! integration of the lock-in equation).
 
-use gyro_lab::bench::lockin::{table, Record, Row, RATIOS};
-use gyro_lab::calibration::lockin::lock_in;
-use gyro_lab::sim::fringe::FringeParams;
+use gyro_lab_core::bench::lockin::{table, Record, Row, RATIOS};
+use gyro_lab_core::calibration::lockin::lock_in;
+use gyro_lab_core::sim::fringe::FringeParams;
 
 /// Without noise the exact relation recovers Omega_L and Omega_I to 1e-5 over
 /// the reference range, with offset, beta and either direction; the published

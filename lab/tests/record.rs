@@ -6,11 +6,11 @@
 mod common;
 
 use common::{dir, json, lab};
-use gyro_lab::sim::board_stream::BoardStream;
+use gyro_lab_core::sim::board_stream::BoardStream;
 
 const FRAME: usize = 86;
 
-fn stream(frames: usize) -> gyro_lab::sim::board_stream::Stream {
+fn stream(frames: usize) -> gyro_lab_core::sim::board_stream::Stream {
     BoardStream {
         frames,
         rate_dps: 10.0,

@@ -7,14 +7,16 @@ mod report_check;
 use common::{json, lab, lab_ok};
 
 use gyro_coeffs::fog_scale_factor::MAX_NODES;
-use gyro_lab::bench::scale_factor::{continuous_fit_test, multipoint_test, validation_test};
-use gyro_lab::calibration::scale_factor::compensation::compensate_rows;
-use gyro_lab::calibration::scale_factor::families::Family;
-use gyro_lab::calibration::scale_factor::fit::fit;
-use gyro_lab::calibration::scale_factor::input::{prepare, SfInput};
-use gyro_lab::calibration::scale_factor::residual::window_rms_ppm;
-use gyro_lab::calibration::scale_factor::result::SfFit;
-use gyro_lab::sim::scale_factor_rig::{simulate, Direction, RigParams, Run, SweepProfile, Test};
+use gyro_lab_core::bench::scale_factor::{continuous_fit_test, multipoint_test, validation_test};
+use gyro_lab_core::calibration::scale_factor::compensation::compensate_rows;
+use gyro_lab_core::calibration::scale_factor::families::Family;
+use gyro_lab_core::calibration::scale_factor::fit::fit;
+use gyro_lab_core::calibration::scale_factor::input::{prepare, SfInput};
+use gyro_lab_core::calibration::scale_factor::residual::window_rms_ppm;
+use gyro_lab_core::calibration::scale_factor::result::SfFit;
+use gyro_lab_core::sim::scale_factor_rig::{
+    simulate, Direction, RigParams, Run, SweepProfile, Test,
+};
 use gyro_sim::ScaleFactorTruth;
 
 fn input(run: &Run) -> SfInput {

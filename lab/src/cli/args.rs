@@ -2,9 +2,9 @@
 //! command's own (`#[command(flatten)]`). Where a command says more about
 //! one in its help, it overrides the help text (`mut_arg`).
 
-use crate::data::read_spec::ReadSpec;
-use crate::data::units::{RateUnit, TempUnit, TimeUnit};
 use clap::Args;
+use gyro_lab_core::data::read_spec::ReadSpec;
+use gyro_lab_core::data::units::{RateUnit, TempUnit, TimeUnit};
 use std::path::PathBuf;
 
 /// `--json`: the last line of stdout is one JSON object.
@@ -54,8 +54,8 @@ pub struct OutOpt {
 pub struct ColumnMap(pub Vec<(String, String)>);
 
 impl std::str::FromStr for ColumnMap {
-    type Err = crate::error::LabError;
-    fn from_str(s: &str) -> Result<Self, crate::error::LabError> {
+    type Err = gyro_lab_core::error::LabError;
+    fn from_str(s: &str) -> Result<Self, gyro_lab_core::error::LabError> {
         ReadSpec::parse_rename(s).map(ColumnMap)
     }
 }
@@ -93,17 +93,17 @@ pub struct RunRead {
 
 impl RunRead {
     /// The spec the readers take, the stretch checked.
-    pub fn spec(&self) -> Result<ReadSpec, crate::error::LabError> {
+    pub fn spec(&self) -> Result<ReadSpec, gyro_lab_core::error::LabError> {
         for (name, v) in [("--from-s", self.from_s), ("--to-s", self.to_s)] {
             if v.is_some_and(|v| !v.is_finite()) {
-                return Err(crate::error::LabError::Usage(format!(
+                return Err(gyro_lab_core::error::LabError::Usage(format!(
                     "{name}: not a finite time"
                 )));
             }
         }
         if let (Some(f), Some(t)) = (self.from_s, self.to_s) {
             if t <= f {
-                return Err(crate::error::LabError::Usage(format!(
+                return Err(gyro_lab_core::error::LabError::Usage(format!(
                     "--from-s {f} --to-s {t}: the stretch is empty"
                 )));
             }

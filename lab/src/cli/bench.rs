@@ -2,21 +2,24 @@
 //! simulators' truth, over seeds), their tables on the terminal and their
 //! JSON line.
 
-use crate::bench::allan::{
+use crate::cli::args::Json;
+use crate::cli::output::{print_json, progress_bar};
+use clap::{Args, Subcommand};
+use gyro_lab_core::bench::allan::{
     against_definition, judge, recovery, speed_record, truth_present, Recovery, Scenario,
     Selection, SAMPLES, SCENARIOS, SHORT, SPEED_TAU0_S, TAU0_S,
 };
-use crate::bench::lockin::{table, RECORDS};
-use crate::bench::scale_factor::{self, ScaleFactorBench};
-use crate::cli::args::Json;
-use crate::cli::output::{print_json, progress_bar};
-use crate::data::csv_writer::CellFormat::{Exp, Fixed};
-use crate::data::run_file::{Column, RunWriter, Series};
-use crate::error::LabError;
-use crate::noise::analysis::{analyse, Allan};
-use crate::noise::terms::{to_units, ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS};
-use crate::sim::scale_factor_rig::RigParams;
-use clap::{Args, Subcommand};
+use gyro_lab_core::bench::lockin::{table, RECORDS};
+use gyro_lab_core::bench::scale_factor::{self, ScaleFactorBench};
+use gyro_lab_core::data::csv_writer::CellFormat::{Exp, Fixed};
+use gyro_lab_core::data::run_file::{Column, RunWriter, Series};
+use gyro_lab_core::data::source::Source;
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::noise::analysis::{analyse, Allan};
+use gyro_lab_core::noise::terms::{
+    to_units, ALL, COUNT, MARKOV, MARKOV_NAME, NAMES, SIN, SIN_NAME, UNITS,
+};
+use gyro_lab_core::sim::scale_factor_rig::RigParams;
 
 #[derive(Subcommand)]
 pub enum BenchCmd {
@@ -32,10 +35,6 @@ pub enum BenchCmd {
     Discover(crate::cli::discover::bench::DiscoverBenchArgs),
     /// The recorder on a ten-minute capture: the CPU it needs at the board's rate.
     Record(crate::cli::bench_record::RecordBenchArgs),
-    /// Discovery on the second generator's held-out set (`simulate heldout`): right, false names, coverage.
-    DiscoverHeldout(crate::cli::discover::bench::HeldOutBenchArgs),
-    /// Discovery beyond the library on the outside generator's cases (`simulate outside`): terms explained, run B predicted, nulls clean, library names kept.
-    DiscoverOutside(crate::cli::bench_outside::OutsideBenchArgs),
     /// The online eps^2 correction over the vibration envelope: the table of issue 23.
     Eps2(crate::cli::bench_eps2::Eps2BenchArgs),
     /// The dithered RLG through the firmware's stripping: ARW against the physics, rate error through the lock-in zones.
@@ -50,8 +49,6 @@ pub fn run(cmd: &BenchCmd) -> Result<(), LabError> {
         BenchCmd::AllanSpeed(a) => allan_speed(a),
         BenchCmd::Discover(a) => crate::cli::discover::bench::discover(a),
         BenchCmd::Record(a) => crate::cli::bench_record::run(a),
-        BenchCmd::DiscoverHeldout(a) => crate::cli::discover::bench::discover_heldout(a),
-        BenchCmd::DiscoverOutside(a) => crate::cli::bench_outside::run_bench(a),
         BenchCmd::Eps2(a) => crate::cli::bench_eps2::run_bench(a),
         BenchCmd::Dither(a) => crate::cli::bench_dither::run_bench(a),
     }
@@ -460,7 +457,11 @@ fn csv_read_s(y: &[f64], tau0: f64) -> Result<f64, LabError> {
     }
     w.finish()?;
     let t1 = std::time::Instant::now();
-    let series = Series::read(&path, Column::Rate.name(), &Default::default())?;
+    let series = Series::read(
+        Source::File(&path),
+        Column::Rate.name(),
+        &Default::default(),
+    )?;
     let read_s = t1.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
     if series.values.len() != y.len() {

@@ -3,11 +3,13 @@
 //! draws across the acceptance ranges, the rate error through the static
 //! band and the dynamic lock-in zones; then the JSON line.
 
-use crate::bench::dither::{arw_plan, arw_row, rate_plan, rate_row, run_all, ArwRow, RateRow};
 use crate::cli::args::Json;
 use crate::cli::output::{print_json, progress_bar};
-use crate::error::LabError;
 use clap::Args;
+use gyro_lab_core::bench::dither::{
+    arw_plan, arw_row, rate_plan, rate_row, run_all, ArwRow, RateRow,
+};
+use gyro_lab_core::error::LabError;
 
 #[derive(Args, Debug, Clone)]
 pub struct DitherBenchArgs {
@@ -85,7 +87,7 @@ pub fn run_bench(a: &DitherBenchArgs) -> Result<(), LabError> {
     };
     let total = (arw_jobs.len() + rate_jobs.len()) as u64;
     let bar = progress_bar(total, "{bar:40} {pos}/{len} {eta}", a.json.json);
-    let tick = |_: usize, _: &crate::sim::dither_run::DitherSummary| bar.inc(1);
+    let tick = |_: usize, _: &gyro_lab_core::sim::dither_run::DitherSummary| bar.inc(1);
     let arw_s =
         run_all(&arw_jobs, threads, &tick).map_err(|e| LabError::Bench(format!("{e:?}")))?;
     let rate_s =

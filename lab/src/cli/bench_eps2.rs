@@ -1,11 +1,11 @@
 //! `gyro-lab bench eps2`: the eps^2 correction over the vibration envelope
 //! (bench/eps2.rs), one row per point, then the JSON line.
 
-use crate::bench::eps2::{envelope, run, summarize, Eps2Plan, Eps2Progress, Eps2Row};
 use crate::cli::args::Json;
 use crate::cli::output::{print_json, progress_bar};
-use crate::error::LabError;
 use clap::Args;
+use gyro_lab_core::bench::eps2::{envelope, run, summarize, Eps2Plan, Eps2Progress, Eps2Row};
+use gyro_lab_core::error::LabError;
 use std::sync::Mutex;
 
 #[derive(Args, Debug, Clone)]

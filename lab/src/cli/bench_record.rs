@@ -6,10 +6,10 @@
 
 use crate::cli::args::Json;
 use crate::cli::output::print_json;
-use crate::error::LabError;
-use crate::sim::board_stream::{BoardStream, RLG_COUNTS_PER_DEG};
 use clap::Args;
 use gyro_frames::{Recorder, Reference, Scales};
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::board_stream::{BoardStream, RLG_COUNTS_PER_DEG};
 
 #[derive(Args, Debug, Clone)]
 pub struct RecordBenchArgs {

@@ -1,32 +1,25 @@
-//! The command layer: one file per command family. Each owns its
-//! arguments, reads and writes the files, prints the JSON and writes the
-//! reports; the domains below (calibration, noise, model, sim, bench) take
-//! typed data and return typed results.
+//! The command line: one file per command family. Each owns its
+//! arguments, checks its output paths, reads and writes the files, prints
+//! the text or the JSON and writes the reports; what a command finds, and
+//! its words, are gyro_lab_core's (commands/), which Python calls too.
 
-pub mod adev_plot;
 pub mod allan;
 pub mod args;
 pub mod bench;
 pub mod bench_dither;
 pub mod bench_eps2;
-pub mod bench_outside;
 pub mod bench_record;
-pub mod checks;
 pub mod compensate;
-pub mod compensate_model;
 pub mod discover;
 pub mod fit;
 pub mod lockin;
-pub mod model_file;
 pub mod out_path;
 pub mod output;
 pub mod record;
-pub mod reports;
-pub mod run_inputs;
 pub mod simulate;
 
-use crate::error::LabError;
 use clap::{Parser, Subcommand};
+use gyro_lab_core::error::LabError;
 
 #[derive(Parser)]
 #[command(

@@ -6,7 +6,7 @@
 //! one sentence at the path, exit 2, before anything is computed or
 //! written.
 
-use crate::error::LabError;
+use gyro_lab_core::error::LabError;
 use std::path::{Path, PathBuf};
 
 /// The kinds of file the lab writes, as far as one can tell them apart.

@@ -1,8 +1,8 @@
 //! What every command does with its results: the JSON line, the report
 //! file, a progress bar on the terminal.
 
-use crate::error::LabError;
-use crate::report::document::Report;
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::report::document::Report;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
 
@@ -18,7 +18,7 @@ pub fn print_json<T: serde::Serialize>(v: &T) -> Result<(), LabError> {
 
 /// Writes a report's HTML to `path`.
 pub fn write_report(report: &Report, path: &Path) -> Result<(), LabError> {
-    crate::data::atomic::write(path, report.html())
+    gyro_lab_core::data::atomic::write(path, report.html())
 }
 
 /// A progress bar of `len` steps drawn with `template`, or a hidden one

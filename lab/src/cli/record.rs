@@ -7,13 +7,13 @@
 use crate::cli::args::{Json, Out, RunRead};
 use crate::cli::out_path::{self, FileKind};
 use crate::cli::output::print_json;
-use crate::data::run_file::{self, Column};
-use crate::data::table::TextTable;
-use crate::error::LabError;
 use clap::Args;
 use gyro_frames::reference::RateLogError;
 use gyro_frames::summary::Summary;
 use gyro_frames::{RateLog, RecordError, Recorder, Reference, Scales};
+use gyro_lab_core::data::run_file::{self, Column};
+use gyro_lab_core::data::table::TextTable;
+use gyro_lab_core::error::LabError;
 use serde::Serialize;
 use std::io::{ErrorKind, Read};
 use std::path::{Path, PathBuf};
@@ -363,7 +363,7 @@ pub fn run(a: &RecordArgs) -> Result<(), LabError> {
     );
     let path = a.out.out.join("record.json");
     let text = serde_json::to_string_pretty(&json).map_err(|e| LabError::io(&path, e))?;
-    crate::data::atomic::write(&path, text + "\n")?;
+    gyro_lab_core::data::atomic::write(&path, text + "\n")?;
     if a.json.json {
         print_json(&json)?;
     } else {

@@ -2,11 +2,11 @@
 //! (sim/chamber.rs), written as a run file.
 
 use crate::cli::args::{Json, Out, Seed};
-use crate::data::csv_writer::CellFormat::Fixed;
-use crate::data::run_file::{Column, RunWriter};
-use crate::error::LabError;
-use crate::sim::chamber::{profile_duration, ChamberProfile, ChamberRun, ChamberRunParams};
 use clap::{Args, ValueEnum};
+use gyro_lab_core::data::csv_writer::CellFormat::Fixed;
+use gyro_lab_core::data::run_file::{Column, RunWriter};
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::chamber::{profile_duration, ChamberProfile, ChamberRun, ChamberRunParams};
 
 /// The chamber profiles, as the command line names them.
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]

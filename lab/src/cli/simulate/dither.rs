@@ -4,11 +4,11 @@
 
 use crate::cli::args::{Json, OutOpt, Seed};
 use crate::cli::output::{print_json, progress_bar};
-use crate::data::csv_writer::{CellFormat, CsvWriter};
-use crate::data::run_file::Column;
-use crate::error::LabError;
-use crate::sim::dither_run::{DitherRow, DitherRun, DitherRunError, DitherSummary, FRAME_HZ};
 use clap::Args;
+use gyro_lab_core::data::csv_writer::{CellFormat, CsvWriter};
+use gyro_lab_core::data::run_file::Column;
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::dither_run::{DitherRow, DitherRun, DitherSummary, FRAME_HZ};
 use gyro_sim::rlg_dither::{Accuracy, DitherParams};
 
 #[derive(Args, Debug, Clone)]
@@ -82,19 +82,6 @@ impl DitherArgs {
             duration_s: self.duration_s,
             settle_s: self.settle_s,
             photodiodes: !self.no_photodiodes,
-        }
-    }
-}
-
-impl From<DitherRunError> for LabError {
-    fn from(e: DitherRunError) -> Self {
-        match e {
-            DitherRunError::OutOfRange(name, v) => {
-                LabError::Usage(format!("--{name} {v}: out of range"))
-            }
-            DitherRunError::Analysis(m) => {
-                LabError::Bench(format!("Allan analysis of the run: {m}"))
-            }
         }
     }
 }

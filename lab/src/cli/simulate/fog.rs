@@ -3,11 +3,13 @@
 
 use crate::cli::args::{Json, OutOpt, Seed};
 use crate::cli::output::{print_json, progress_bar};
-use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
-use crate::data::run_file::{Column, RunWriter};
-use crate::error::LabError;
-use crate::sim::fog_run::{FogRow, FogRun, FogRunError, FogRunParam, FogRunParams, Vibration};
 use clap::Args;
+use gyro_lab_core::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
+use gyro_lab_core::data::run_file::{Column, RunWriter};
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::fog_run::{
+    FogRow, FogRun, FogRunError, FogRunParam, FogRunParams, Vibration,
+};
 
 #[derive(Args, Debug, Clone)]
 #[command(

@@ -2,10 +2,10 @@
 //! (sim/fringe.rs), written as a fringe file.
 
 use crate::cli::args::{Json, Out, Seed};
-use crate::data::fringe_file::FringeWriter;
-use crate::error::LabError;
-use crate::sim::fringe::FringeParams;
 use clap::Args;
+use gyro_lab_core::data::fringe_file::FringeWriter;
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::fringe::FringeParams;
 
 /// `gyro-lab simulate lockin`: writes a fringe file.
 #[derive(Args, Debug, Clone)]

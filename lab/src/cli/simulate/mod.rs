@@ -4,15 +4,13 @@
 pub mod chamber;
 pub mod dither;
 pub mod fog;
-pub mod heldout;
 pub mod lockin;
-pub mod outside;
 pub mod run;
 pub mod scale_factor;
 
 use crate::cli::out_path::{self, FileKind};
-use crate::error::LabError;
 use clap::Subcommand;
+use gyro_lab_core::error::LabError;
 use std::path::Path;
 
 #[derive(Subcommand)]
@@ -29,10 +27,6 @@ pub enum SimulateCmd {
     ScaleFactor(scale_factor::SimulateArgs),
     /// A gyro model (model.toml) on a test profile with the project's noise: a run with known effects.
     Run(run::SimulateRunArgs),
-    /// The second, independent generator's held-out set for discovery (runs and truth.json).
-    Heldout(heldout::HeldOutArgs),
-    /// The outside generator's cases for discovery beyond the library: two runs of one gyro per case, their hidden terms and truth.json.
-    Outside(outside::OutsideArgs),
 }
 
 /// The run file a simulation writes: refused where it names the model
@@ -68,7 +62,6 @@ pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
             a.out.force,
             &[("--model", &a.model)],
         )?,
-        SimulateCmd::Heldout(_) | SimulateCmd::Outside(_) => {}
     }
     match cmd {
         SimulateCmd::Fog(a) => fog::run(a),
@@ -77,7 +70,5 @@ pub fn run(cmd: &SimulateCmd) -> Result<(), LabError> {
         SimulateCmd::Dither(a) => dither::run(a),
         SimulateCmd::ScaleFactor(a) => scale_factor::run(a),
         SimulateCmd::Run(a) => run::run(a),
-        SimulateCmd::Heldout(a) => heldout::run(a),
-        SimulateCmd::Outside(a) => outside::run(a),
     }
 }

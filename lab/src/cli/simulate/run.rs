@@ -3,12 +3,13 @@
 //! known effects.
 
 use crate::cli::args::{Json, Out, Seed};
-use crate::cli::model_file::read_model_file;
-use crate::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
-use crate::data::run_file::{Column, RunWriter};
-use crate::error::LabError;
-use crate::sim::model_run::{generate, TestProfile, TrialNoise, TrialRun};
 use clap::{Args, ValueEnum};
+use gyro_lab_core::commands::model_file::read_model_file;
+use gyro_lab_core::commands::simulate_run::{columns, simulate_run, SimulateRequest};
+use gyro_lab_core::data::csv_writer::CellFormat::{Exp, Fixed, Shortest};
+use gyro_lab_core::data::run_file::{Column, RunWriter};
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::model_run::{TestProfile, TrialRun};
 use std::path::PathBuf;
 
 /// Test profiles, as the command line names them.
@@ -56,41 +57,20 @@ impl From<TestProfileArg> for TestProfile {
 
 /// Writes a run file: the required columns, then those the profile has.
 pub fn write(run: &TrialRun, path: &std::path::Path, comment: &str) -> Result<(), LabError> {
-    let inp = &run.inputs;
-    let mut cols = vec![
-        (Column::Time, Shortest),
-        (Column::RefRate, Fixed(9)),
-        (Column::Rate, Exp(12)),
-    ];
-    if inp.temp.is_some() {
-        cols.push((Column::Temp, Fixed(4)));
-    }
-    if run.mono.is_some() {
-        cols.extend([(Column::MonoA, Fixed(4)), (Column::MonoB, Fixed(4))]);
-    }
-    if run.case.is_some() {
-        cols.push((Column::Case, Fixed(4)));
-    }
-    if run.acc_column {
-        cols.push((Column::RefAcc, Fixed(6)));
-    }
-    let mut w = RunWriter::create(path, comment, &cols)?;
+    let cols = columns(run);
+    let format = |c: Column| match c {
+        Column::Time => Shortest,
+        Column::RefRate => Fixed(9),
+        Column::Rate => Exp(12),
+        Column::RefAcc => Fixed(6),
+        _ => Fixed(4),
+    };
+    let spec: Vec<(Column, _)> = cols.iter().map(|(c, _)| (*c, format(*c))).collect();
+    let mut w = RunWriter::create(path, comment, &spec)?;
     let mut row = Vec::with_capacity(cols.len());
-    for k in 0..inp.len() {
+    for k in 0..run.inputs.len() {
         row.clear();
-        row.extend([inp.t[k], inp.w[k], run.rate[k]]);
-        if let Some(tc) = &inp.temp {
-            row.push(tc[k]);
-        }
-        if let Some((a, b)) = &run.mono {
-            row.extend([a[k], b[k]]);
-        }
-        if let Some(c) = &run.case {
-            row.push(c[k]);
-        }
-        if run.acc_column {
-            row.push(inp.acc[k]);
-        }
+        row.extend(cols.iter().map(|(_, v)| v[k]));
         w.row(&row)?;
     }
     w.finish()
@@ -133,31 +113,27 @@ pub struct SimulateRunArgs {
 pub fn run(a: &SimulateRunArgs) -> Result<(), LabError> {
     let profile = TestProfile::from(a.profile);
     let file = read_model_file(&a.model, profile.gyro())?;
-    let (dt0, dur0) = profile.default_timing();
-    let dt = a.dt_s.unwrap_or(dt0);
-    let dur = a.duration_s.unwrap_or(dur0);
-    if !(dt.is_finite() && dt > 0.0 && dur.is_finite() && dur >= 10.0 * dt && dur / dt <= 2e7) {
-        return Err(LabError::Usage(format!(
-            "--dt-s {dt} --duration-s {dur}: out of range"
-        )));
-    }
-    let nom = TrialNoise::nominal(profile.gyro());
-    let noise = TrialNoise {
-        arw_dpsh: a.arw_dpsh.unwrap_or(nom.arw_dpsh).max(0.0),
-        bias_instability_dph: a
-            .bias_instability_dph
-            .unwrap_or(nom.bias_instability_dph)
-            .max(0.0),
-        rate_random_walk_dphsh: a
-            .rate_random_walk_dphsh
-            .unwrap_or(nom.rate_random_walk_dphsh)
-            .max(0.0),
-    };
-    let model = &file.model;
-    let run = generate(model, profile, noise, a.seed.seed, Some((dt, dur)));
-    // A term must be computable on the profile's inputs: refused at its
-    // place before anything is written (its rows would be NaN).
-    file.check_terms(&run.inputs)?;
+    let (run, noise) = simulate_run(&SimulateRequest {
+        model: &file,
+        profile,
+        dt_s: a.dt_s,
+        duration_s: a.duration_s,
+        arw_dpsh: a.arw_dpsh,
+        bias_instability_dph: a.bias_instability_dph,
+        rate_random_walk_dphsh: a.rate_random_walk_dphsh,
+        seed: a.seed.seed,
+    })
+    .map_err(|e| match e {
+        LabError::Usage(_) => {
+            let (dt0, dur0) = profile.default_timing();
+            LabError::Usage(format!(
+                "--dt-s {} --duration-s {}: out of range",
+                a.dt_s.unwrap_or(dt0),
+                a.duration_s.unwrap_or(dur0)
+            ))
+        }
+        e => e,
+    })?;
     write(
         &run,
         &a.out.out,

@@ -3,11 +3,11 @@
 
 use crate::cli::args::{Json, Out, Seed};
 use crate::cli::output::print_json;
-use crate::data::csv_writer::CellFormat::Fixed;
-use crate::data::run_file::{Column, RunWriter};
-use crate::error::LabError;
-use crate::sim::scale_factor_rig::{simulate, Direction, RigParams, SweepProfile, Test};
 use clap::{Args, ValueEnum};
+use gyro_lab_core::data::csv_writer::CellFormat::Fixed;
+use gyro_lab_core::data::run_file::{Column, RunWriter};
+use gyro_lab_core::error::LabError;
+use gyro_lab_core::sim::scale_factor_rig::{simulate, Direction, RigParams, SweepProfile, Test};
 use gyro_sim::fog_thermal::MAX_KNEES;
 
 /// Chamber profiles of the continuous-rotation test, as the command line
