@@ -136,7 +136,7 @@ pub fn read(path: &Path) -> Result<(CoeffFile, Coeffs), String> {
 /// [`read`] of a coefficient file's text; `name` (a path, or what the
 /// caller calls the text) starts its errors.
 pub fn parse(text: &str, name: &str) -> Result<(CoeffFile, Coeffs), String> {
-    let f: CoeffFile = toml::from_str(&text).map_err(|e| {
+    let f: CoeffFile = toml::from_str(text).map_err(|e| {
         let msg = e.message().replace('\n', " ");
         match e.span() {
             Some(s) => {

@@ -101,7 +101,8 @@ fn repository_sources(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
         } else if p
             .extension()
             .is_some_and(|x| x == "rs" || x == "py" || x == "sh")
-            || p.parent().is_some_and(|d| d.ends_with(".ci"))
+            || p.parent()
+                .is_some_and(|d| d.file_name().is_some_and(|n| n == ".ci"))
         {
             out.push(p);
         }

@@ -94,6 +94,7 @@ fn check(
         name: rate_name,
         given: spec.rate_unit,
         reference_given: spec.ref_rate_unit,
+        period_s: Some(sampling.period_s),
     })
     .map_err(|r| refuse(r.0))?;
     warnings.extend(u.warnings);

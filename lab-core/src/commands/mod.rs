@@ -12,6 +12,7 @@ pub mod compensate;
 pub mod discover;
 pub mod fit_scale_factor;
 pub mod fit_thermal;
+pub mod frames;
 pub mod lockin;
 pub mod model_file;
 pub mod reports;

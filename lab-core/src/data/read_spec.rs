@@ -65,6 +65,26 @@ impl ReadSpec {
         Ok(out)
     }
 
+    /// The stretch asked for checked: finite times, the end after the
+    /// start; `names` are what the caller calls the two (`--from-s` and
+    /// `--to-s` on the command line).
+    pub fn check_stretch(&self, names: [&str; 2]) -> Result<(), LabError> {
+        for (name, v) in names.iter().zip([self.from_s, self.to_s]) {
+            if v.is_some_and(|v| !v.is_finite()) {
+                return Err(LabError::Usage(format!("{name}: not a finite time")));
+            }
+        }
+        if let (Some(f), Some(t)) = (self.from_s, self.to_s) {
+            if t <= f {
+                return Err(LabError::Usage(format!(
+                    "{} {f} {} {t}: the stretch is empty",
+                    names[0], names[1]
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Whether a time `t` (s) is inside the stretch asked for.
     pub fn keeps(&self, t: f64) -> bool {
         self.from_s.is_none_or(|f| t >= f) && self.to_s.is_none_or(|e| t <= e)
@@ -86,6 +106,10 @@ impl ReadSpec {
 pub struct ColumnRule {
     pub scale: f64,
     pub offset: f64,
+    /// Converted values in this closed range are inside the column's
+    /// physical range without asking `check` (the common case, read at
+    /// the cost of two comparisons).
+    pub valid: (f64, f64),
     /// The message for a converted value outside the column's physical
     /// range (None inside it).
     pub check: Option<Box<dyn Fn(f64) -> Option<String>>>,
@@ -97,8 +121,17 @@ impl ColumnRule {
         Self {
             scale: 1.0,
             offset: 0.0,
+            valid: (f64::NEG_INFINITY, f64::INFINITY),
             check: None,
         }
+    }
+
+    /// What is wrong with the converted value `v`, if anything.
+    pub fn problem(&self, v: f64) -> Option<String> {
+        if v >= self.valid.0 && v <= self.valid.1 {
+            return None;
+        }
+        self.check.as_ref().and_then(|c| c(v))
     }
 }
 

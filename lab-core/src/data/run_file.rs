@@ -149,6 +149,7 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
         ColumnRule {
             scale: rate.angle_to_deg(),
             offset: 0.0,
+            valid: (-1e8, 1e8),
             check: range(
                 -1e8,
                 1e8,
@@ -160,6 +161,7 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
         ColumnRule {
             scale: rate.to_dps(),
             offset: 0.0,
+            valid: (-1e5, 1e5),
             check: Some(Box::new(move |v: f64| {
                 const MAX: f64 = 1e5;
                 (v.abs() > MAX).then(|| {
@@ -179,6 +181,7 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
         ColumnRule {
             scale: rate.angle_to_deg(),
             offset: 0.0,
+            valid: (f64::NEG_INFINITY, f64::INFINITY),
             check: None,
         }
     } else if name.ends_with("_c") {
@@ -189,6 +192,7 @@ pub fn rule(name: &str, spec: &ReadSpec) -> ColumnRule {
         ColumnRule {
             scale: unit.scale(),
             offset: unit.to_c(0.0),
+            valid: (lo, hi),
             check: Some(Box::new(move |v: f64| {
                 if (lo..=hi).contains(&v) {
                     return None;

@@ -100,7 +100,7 @@ impl Reader {
                 None => return Err(CellError::NotANumber(cell)),
             },
         };
-        match self.rule.check.as_ref().and_then(|c| c(v)) {
+        match self.rule.problem(v) {
             Some(m) => Err(CellError::OutOfRange(format!("`{cell}` {m}"))),
             None => Ok(v),
         }
@@ -116,7 +116,7 @@ impl Reader {
             Some(unit) => x * unit,
             None => self.rule.scale * x + self.rule.offset,
         };
-        match self.rule.check.as_ref().and_then(|c| c(v)) {
+        match self.rule.problem(v) {
             Some(m) => Err(CellError::OutOfRange(format!("`{x}` {m}"))),
             None => Ok(v),
         }
@@ -703,34 +703,48 @@ impl ColumnStream {
         let at = |row: usize, k: usize, m: CellError| {
             origin.cell(row as u64, fields[k], &shown[k], m.to_string())
         };
-        // Time first: it decides the rows kept.
+        // Time first: it decides the rows kept (all of them, read in one
+        // pass, where no stretch was asked for).
         let time_k = plan.time.and_then(|t| cols.iter().position(|c| *c == t));
         let n = columns.len();
-        let mut rows: Vec<usize> = (0..n).collect();
+        let whole = plan.spec.from_s.is_none() && plan.spec.to_s.is_none();
+        let mut rows: Option<Vec<usize>> = None;
         let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
-        if let Some(k) = time_k {
+        let read = |k: usize, rows: Option<&[usize]>| -> Result<Vec<f64>, LabError> {
             let mut reader = Reader::new(&plan, cols[k], dialect);
             let v = &columns.values[fields[k] - 1];
-            let mut t = Vec::with_capacity(n);
-            let mut kept = Vec::with_capacity(n);
-            for r in 0..n {
-                let x = reader.value(v[r]).map_err(|m| at(r, k, m))?;
-                if plan.spec.keeps(x) {
-                    t.push(x);
-                    kept.push(r);
+            let mut out = Vec::with_capacity(rows.map_or(n, |r| r.len()));
+            match rows {
+                None => {
+                    for (r, &x) in v.iter().enumerate() {
+                        out.push(reader.value(x).map_err(|m| at(r, k, m))?);
+                    }
+                }
+                Some(rows) => {
+                    for &r in rows {
+                        out.push(reader.value(v[r]).map_err(|m| at(r, k, m))?);
+                    }
                 }
             }
-            data[k] = t;
-            rows = kept;
+            Ok(out)
+        };
+        if let Some(k) = time_k {
+            let t = read(k, None)?;
+            if whole {
+                data[k] = t;
+            } else {
+                let kept: Vec<usize> = (0..n).filter(|&r| plan.spec.keeps(t[r])).collect();
+                data[k] = kept.iter().map(|&r| t[r]).collect();
+                rows = Some(kept);
+            }
         }
         for k in (0..cols.len()).filter(|&k| Some(k) != time_k) {
-            let mut reader = Reader::new(&plan, cols[k], dialect);
-            let v = &columns.values[fields[k] - 1];
-            data[k] = rows
-                .iter()
-                .map(|&r| reader.value(v[r]).map_err(|m| at(r, k, m)))
-                .collect::<Result<_, _>>()?;
+            data[k] = read(k, rows.as_deref())?;
         }
+        let lines: Vec<u64> = match &rows {
+            None => (0..n as u64).collect(),
+            Some(r) => r.iter().map(|&r| r as u64).collect(),
+        };
         Ok((
             Self {
                 origin,
@@ -738,7 +752,7 @@ impl ColumnStream {
                 data,
                 names: cols.iter().map(|c| (*c).to_owned()).collect(),
                 shown,
-                lines: rows.iter().map(|&r| r as u64).collect(),
+                lines,
                 fields,
             },
             present,

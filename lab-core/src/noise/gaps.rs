@@ -11,6 +11,7 @@
 //! passes unchanged; the filled share is reported so a user can judge it.
 
 use super::analysis::{SamplingError, SAMPLING_TOLERANCE};
+use std::borrow::Cow;
 
 /// A uniform series made from one with gaps.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,27 +48,50 @@ pub const MAX_GAP_SAMPLES: f64 = 10_000.0;
 /// shorter ones rows taken early: either way the record is resampled
 /// through its angle. A longer gap is an error at its row.
 pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
+    fill_gaps_cow(t, Cow::Borrowed(values), None)
+}
+
+/// [`fill_gaps`] of values the caller gives up (a uniform record keeps
+/// them, no copy), `median` the median interval of `t` where the caller
+/// has it.
+pub fn fill_gaps_owned(
+    t: &[f64],
+    values: Vec<f64>,
+    median: Option<f64>,
+) -> Result<Filled, SamplingError> {
+    fill_gaps_cow(t, Cow::Owned(values), median)
+}
+
+fn fill_gaps_cow(
+    t: &[f64],
+    values: Cow<[f64]>,
+    median: Option<f64>,
+) -> Result<Filled, SamplingError> {
     let n = t.len().min(values.len());
-    let uniform = |tau0| Filled {
-        values: values[..n].to_vec(),
-        tau0,
-        gaps: 0,
-        stretched: 0,
-        filled: 0,
+    let uniform = |tau0, values: Cow<[f64]>| {
+        let mut values = values.into_owned();
+        values.truncate(n);
+        Filled {
+            values,
+            tau0,
+            gaps: 0,
+            stretched: 0,
+            filled: 0,
+        }
     };
     if n < 2 {
-        return Ok(uniform(1.0));
+        return Ok(uniform(1.0, values));
     }
-    let d: Vec<f64> = t[..n].windows(2).map(|w| w[1] - w[0]).collect();
-    let mut sorted = d.clone();
-    sorted.sort_by(f64::total_cmp);
-    let med = sorted[sorted.len() / 2];
+    let interval = |k: usize| t[k + 1] - t[k];
+    let med = median.unwrap_or_else(|| {
+        crate::numerics::stats::median_mut(&mut (0..n - 1).map(interval).collect::<Vec<f64>>())
+    });
     if med.is_nan() || med <= 0.0 {
         return Err(SamplingError::NotIncreasing);
     }
     let tol = SAMPLING_TOLERANCE * med;
     let (mut gaps, mut stretched) = (0, 0);
-    for (k, &h) in d.iter().enumerate() {
+    for (k, h) in (0..n - 1).map(interval).enumerate() {
         if (h - med).abs() <= tol {
             continue;
         }
@@ -89,14 +113,14 @@ pub fn fill_gaps(t: &[f64], values: &[f64]) -> Result<Filled, SamplingError> {
         }
     }
     if gaps + stretched == 0 {
-        return Ok(uniform(med));
+        return Ok(uniform(med, values));
     }
     // The angle at each row's time (rate held over the interval before it),
     // read on the grid t0 + k med by linear interpolation.
     let mut angle = Vec::with_capacity(n);
     angle.push(0.0);
     for k in 1..n {
-        angle.push(angle[k - 1] + values[k] * d[k - 1]);
+        angle.push(angle[k - 1] + values[k] * interval(k - 1));
     }
     let span = t[n - 1] - t[0];
     let m = ((span + tol) / med).floor() as usize;

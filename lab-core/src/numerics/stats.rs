@@ -189,3 +189,57 @@ mod tests {
         assert!(batch_mean_se(&[1.0], 10).is_none());
     }
 }
+
+/// The median of `v`: the element at index len/2 of the sorted values
+/// (by `total_cmp`), selected in linear time on a copy. NaN for an empty
+/// slice.
+pub fn median(v: &[f64]) -> f64 {
+    median_mut(&mut v.to_vec())
+}
+
+/// [`median`] of values the caller owns and no longer needs in order:
+/// reordered in place, no copy.
+pub fn median_mut(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let k = v.len() / 2;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+#[cfg(test)]
+mod median_tests {
+    use super::median;
+
+    #[test]
+    fn the_median_is_the_middle_element_of_the_sorted_values() {
+        let mut s: u64 = 7;
+        let mut r = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for n in [1usize, 2, 3, 10, 1001, 4096, 20_000, 70_001] {
+            for kind in 0..4 {
+                let v: Vec<f64> = (0..n)
+                    .map(|_| match kind {
+                        // Nearly equal intervals, as a clock's.
+                        0 => 0.01 + (r() % 5) as f64 * 1e-17,
+                        1 => (r() % 1000) as f64 - 500.0,
+                        2 => f64::from_bits(r() >> 2) * if r() % 2 == 0 { -1.0 } else { 1.0 },
+                        _ => -0.0,
+                    })
+                    .collect();
+                let mut w = v.clone();
+                w.sort_by(f64::total_cmp);
+                assert_eq!(
+                    median(&v).to_bits(),
+                    w[n / 2].to_bits(),
+                    "n {n} kind {kind}"
+                );
+            }
+        }
+        assert!(median(&[]).is_nan());
+    }
+}

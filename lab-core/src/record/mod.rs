@@ -55,10 +55,9 @@ pub(crate) fn white_sd(x: &[f64]) -> f64 {
         return 0.0;
     }
     let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
-    let k = d.len() / 2;
-    let (_, med, _) = d.select_nth_unstable_by(k, f64::total_cmp);
-    if *med > 0.0 {
-        *med / (0.674_489_750 * std::f64::consts::SQRT_2)
+    let med = crate::numerics::stats::median_mut(&mut d);
+    if med > 0.0 {
+        med / (0.674_489_750 * std::f64::consts::SQRT_2)
     } else {
         rms / std::f64::consts::SQRT_2
     }

@@ -16,6 +16,7 @@
 //!   the angle (noise/gaps.rs).
 
 use super::Warning;
+use crate::numerics::stats::{median, median_mut};
 
 /// The relative spread of intervals below which a record is uniform.
 pub const UNIFORM_TOLERANCE: f64 = 1e-4;
@@ -67,11 +68,6 @@ impl Sampling {
     }
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    let k = v.len() / 2;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
 /// Judges the times `t` (increasing) and, for a jittered record, puts
 /// them on their grid in place.
 pub fn regularise(t: &mut [f64]) -> Sampling {
@@ -88,14 +84,16 @@ pub fn regularise(t: &mut [f64]) -> Sampling {
     if n < 3 {
         return uniform(d.first().copied().unwrap_or(1.0));
     }
-    let med = median(&mut d.clone());
-    if d.iter().all(|h| (h - med).abs() <= UNIFORM_TOLERANCE * med) {
+    let med = median_mut(&mut d);
+    if t.windows(2)
+        .all(|w| (w[1] - w[0] - med).abs() <= UNIFORM_TOLERANCE * med)
+    {
         return uniform(med);
     }
     // Each row's slot on the grid, counted from the intervals.
     let mut slot = vec![0i64; n];
     for k in 1..n {
-        slot[k] = slot[k - 1] + ((d[k - 1] / med).round() as i64).max(1);
+        slot[k] = slot[k - 1] + (((t[k] - t[k - 1]) / med).round() as i64).max(1);
     }
     let gaps = (1..n).filter(|&k| slot[k] - slot[k - 1] > 1).count();
     // The period by least squares of the stamps on their slots (the
@@ -121,7 +119,7 @@ pub fn regularise(t: &mut [f64]) -> Sampling {
         .enumerate()
         .map(|(b, c)| {
             let mid = (b * BLOCK) as f64 + 0.5 * (c.len() - 1) as f64;
-            (mid, median(&mut c.to_vec()))
+            (mid, median(c))
         })
         .collect();
     let smooth = |k: usize| -> f64 {

@@ -29,6 +29,9 @@ pub struct RateColumn<'a> {
     pub name: &'a str,
     pub given: Option<RateUnit>,
     pub reference_given: Option<RateUnit>,
+    /// The rows' period, s, where the caller has judged it (the median
+    /// interval of `t` otherwise).
+    pub period_s: Option<f64>,
 }
 
 /// The outcome: warnings, and how far the unit could be checked.
@@ -122,24 +125,30 @@ fn grade_of(arw_dpsh: f64, bias_dph: f64) -> Option<&'static str> {
 /// The step of the grid `x` lies on, if it lies on one (at least 90 % of
 /// the nonzero differences whole multiples of the smallest).
 fn grid_step(x: &[f64]) -> Option<f64> {
-    let mut d: Vec<f64> = x
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .filter(|v| *v > 0.0)
-        .collect();
-    if d.len() < 20 {
+    // Two passes over the differences, none kept (a day at 100 Hz is 10^7
+    // of them); the second stops once a tenth are off the grid, as they
+    // are at once in a record that lies on none.
+    let steps = || {
+        x.windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .filter(|v| *v > 0.0)
+    };
+    let (n, q) = steps().fold((0usize, f64::INFINITY), |(n, q), v| (n + 1, q.min(v)));
+    if n < 20 || q <= 0.0 {
         return None;
     }
-    d.sort_by(f64::total_cmp);
-    let q = d[0];
-    let on = d
-        .iter()
-        .filter(|v| {
-            let k = *v / q;
-            (k - k.round()).abs() < 1e-6 * k.max(1.0)
-        })
-        .count();
-    (on * 10 >= d.len() * 9 && q > 0.0).then_some(q)
+    let allowed_off = n - (n * 9).div_ceil(10);
+    let mut off = 0;
+    for v in steps() {
+        let k = v / q;
+        if (k - k.round()).abs() >= 1e-6 * k.max(1.0) {
+            off += 1;
+            if off > allowed_off {
+                return None;
+            }
+        }
+    }
+    Some(q)
 }
 
 /// Whether `v` is a round decimal (1, 2, 2.5 or 5 times a power of ten, or
@@ -254,9 +263,9 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
             return Ok(out);
         }
     }
-    let bias: Vec<f64> = match c.reference_dps {
+    let bias: std::borrow::Cow<[f64]> = match c.reference_dps {
         Some(w) => c.rate_dps.iter().zip(w).map(|(y, w)| y - w).collect(),
-        None => c.rate_dps.to_vec(),
+        None => std::borrow::Cow::Borrowed(c.rate_dps),
     };
     let (mean_bias, _) = mean_sd(&bias);
     let sd = white_sd(&bias);
@@ -280,7 +289,7 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
         }
     }
     // 5: the grade the white noise and the bias fit.
-    let dt = median_interval(c.t);
+    let dt = c.period_s.unwrap_or_else(|| median_interval(c.t));
     let arw = sd * dt.sqrt() * 60.0;
     let bias_dph = mean_bias * 3600.0;
     if arw > 0.0 && grade_of(arw, bias_dph).is_none() {
@@ -321,8 +330,7 @@ pub fn median_interval(t: &[f64]) -> f64 {
     if d.is_empty() {
         return 1.0;
     }
-    let k = d.len() / 2;
-    *d.select_nth_unstable_by(k, f64::total_cmp).1
+    crate::numerics::stats::median_mut(&mut d)
 }
 
 #[cfg(test)]
@@ -358,6 +366,7 @@ mod tests {
             name,
             given: None,
             reference_given: None,
+            period_s: None,
         }
     }
 

@@ -109,6 +109,18 @@ impl Report {
         );
     }
 
+    /// The report as a fragment to place in another page (a notebook's
+    /// output cell): the same title, verdict, plots and tables, its style
+    /// kept to itself.
+    pub fn fragment(&self) -> String {
+        format!(
+            "<div class=\"gyro-report\">\n<style>{}</style>\n<h1>{}</h1>\n{}</div>\n",
+            scoped_css(".gyro-report"),
+            esc(&self.title),
+            self.body
+        )
+    }
+
     pub fn html(&self) -> String {
         format!(
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{t}</title>\n\
@@ -116,5 +128,40 @@ impl Report {
             self.body,
             t = esc(&self.title)
         )
+    }
+}
+
+/// The report's style with every rule kept inside `scope` (`body` is the
+/// scope itself).
+fn scoped_css(scope: &str) -> String {
+    CSS.split_inclusive('}')
+        .filter_map(|rule| {
+            let (sel, body) = rule.split_once('{')?;
+            let sel: Vec<String> = sel
+                .split(',')
+                .map(|s| match s.trim() {
+                    "body" => scope.to_owned(),
+                    s => format!("{scope} {s}"),
+                })
+                .collect();
+            Some(format!("{}{{{body}", sel.join(",")))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fragment_keeps_its_style_to_itself() {
+        let css = scoped_css(".r");
+        assert!(css.starts_with(".r{font-family:sans-serif"), "{css}");
+        assert!(css.contains(".r td,.r th{border"), "{css}");
+        assert!(!css.contains("}body") && !css.contains("{body"), "{css}");
+        let mut r = Report::new("t");
+        r.paragraph("p");
+        let f = r.fragment();
+        assert!(f.starts_with("<div class=\"gyro-report\">") && f.contains("<p>p</p>"));
     }
 }

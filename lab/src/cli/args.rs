@@ -5,6 +5,7 @@
 use clap::Args;
 use gyro_lab_core::data::read_spec::ReadSpec;
 use gyro_lab_core::data::units::{RateUnit, TempUnit, TimeUnit};
+use gyro_lab_core::error::LabError;
 use std::path::PathBuf;
 
 /// `--json`: the last line of stdout is one JSON object.
@@ -93,22 +94,8 @@ pub struct RunRead {
 
 impl RunRead {
     /// The spec the readers take, the stretch checked.
-    pub fn spec(&self) -> Result<ReadSpec, gyro_lab_core::error::LabError> {
-        for (name, v) in [("--from-s", self.from_s), ("--to-s", self.to_s)] {
-            if v.is_some_and(|v| !v.is_finite()) {
-                return Err(gyro_lab_core::error::LabError::Usage(format!(
-                    "{name}: not a finite time"
-                )));
-            }
-        }
-        if let (Some(f), Some(t)) = (self.from_s, self.to_s) {
-            if t <= f {
-                return Err(gyro_lab_core::error::LabError::Usage(format!(
-                    "--from-s {f} --to-s {t}: the stretch is empty"
-                )));
-            }
-        }
-        Ok(ReadSpec {
+    pub fn spec(&self) -> Result<ReadSpec, LabError> {
+        let spec = ReadSpec {
             rename: self.columns.clone().map(|c| c.0).unwrap_or_default(),
             rate_unit: self.rate_unit,
             ref_rate_unit: self.ref_rate_unit,
@@ -116,10 +103,11 @@ impl RunRead {
             time_unit: self.time_unit,
             from_s: self.from_s,
             to_s: self.to_s,
-        })
+        };
+        spec.check_stretch(["--from-s", "--to-s"])?;
+        Ok(spec)
     }
 }
-
 /// `--no-report`: skip the report a command writes beside its output
 /// (for scripted loops; the JSON and the other files are unchanged).
 #[derive(Args, Debug, Clone, Copy)]

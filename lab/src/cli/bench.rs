@@ -387,8 +387,8 @@ fn print_allan(r: &Recovery, n: u64) {
     );
     let unit = |j: usize| if j < COUNT { UNITS[j] } else { "deg/h" };
     print!("{:<34}", "scenario");
-    for j in 0..ALL {
-        print!(" {:>22}", format!("{} ({})", SHORT[j], unit(j)));
+    for (j, short) in SHORT.iter().enumerate().take(ALL) {
+        print!(" {:>22}", format!("{short} ({})", unit(j)));
     }
     println!(" {:>10} {:>8}", "consistent", "filter");
     for row in &r.rows {

@@ -9,12 +9,11 @@ use crate::cli::out_path::{self, FileKind};
 use crate::cli::output::print_json;
 use clap::Args;
 use gyro_frames::reference::RateLogError;
-use gyro_frames::summary::Summary;
 use gyro_frames::{RateLog, RecordError, Recorder, Reference, Scales};
+use gyro_lab_core::commands::frames::{summary_json, RecordJson};
 use gyro_lab_core::data::run_file::{self, Column};
 use gyro_lab_core::data::table::TextTable;
 use gyro_lab_core::error::LabError;
-use serde::Serialize;
 use std::io::{ErrorKind, Read};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -68,113 +67,6 @@ const PROGRESS_EVERY: Duration = Duration::from_millis(500);
 /// On a stderr that is not a terminal (a log file, a pipe), a plain line
 /// this often instead of the redrawn one: no terminal escape codes.
 const PROGRESS_LOG_EVERY: Duration = Duration::from_secs(10);
-
-/// `record.json` and the `--json` line.
-#[derive(Serialize)]
-struct RecordJson {
-    source: String,
-    /// Host seconds the record took.
-    elapsed_s: f64,
-    /// Board time of the first and last frame, s.
-    first_s: f64,
-    last_s: f64,
-    frames: u64,
-    bytes: u64,
-    crc_errors: u64,
-    resyncs: u64,
-    skipped_bytes: u64,
-    duplicates: u64,
-    /// Frames lost on the way, with the sequence numbers either side.
-    lost_frames: Vec<LostJson>,
-    lost_frame_count: u64,
-    /// Closures the board reported missed (their angle is lost).
-    closures_missed: u64,
-    /// Each fault flag seen: frames with it, first and last board time.
-    faults: std::collections::BTreeMap<String, FlagJson>,
-    /// Starts of the board the record saw: board time and cause.
-    starts: Vec<(f64, String)>,
-    /// The angle over the record: FOG (deg, eps^2-corrected, nominal scale
-    /// factor) and RLG (counts, deg).
-    fog_angle_deg: f64,
-    rlg_counts: i64,
-    rlg_angle_deg: f64,
-    /// Why the record ended early, if it did.
-    error: Option<String>,
-}
-
-#[derive(Serialize)]
-struct LostJson {
-    after_seq: u16,
-    before_seq: u16,
-    frames: u32,
-    from_s: f64,
-    to_s: f64,
-}
-
-#[derive(Serialize)]
-struct FlagJson {
-    frames: u64,
-    first_s: f64,
-    last_s: f64,
-}
-
-fn summary_json(
-    s: &Summary,
-    source: &str,
-    elapsed: Duration,
-    angles: (f64, i64),
-    counts_per_deg: f64,
-    error: Option<String>,
-) -> RecordJson {
-    RecordJson {
-        source: source.to_string(),
-        elapsed_s: elapsed.as_secs_f64(),
-        first_s: s.first_s,
-        last_s: s.last_s,
-        frames: s.frames,
-        bytes: s.bytes,
-        crc_errors: s.crc_errors,
-        resyncs: s.resyncs,
-        skipped_bytes: s.skipped_bytes,
-        duplicates: s.duplicates,
-        lost_frames: s
-            .lost
-            .iter()
-            .map(|l| LostJson {
-                after_seq: l.after_seq,
-                before_seq: l.before_seq,
-                frames: l.frames,
-                from_s: l.from_s,
-                to_s: l.to_s,
-            })
-            .collect(),
-        lost_frame_count: s.lost_frames,
-        closures_missed: s.closures_missed,
-        faults: s
-            .flags
-            .iter()
-            .map(|f| {
-                (
-                    f.name.clone(),
-                    FlagJson {
-                        frames: f.frames,
-                        first_s: f.first_s,
-                        last_s: f.last_s,
-                    },
-                )
-            })
-            .collect(),
-        starts: s
-            .starts
-            .iter()
-            .map(|(t, c)| (*t, format!("{c:?}")))
-            .collect(),
-        fog_angle_deg: angles.0,
-        rlg_counts: angles.1,
-        rlg_angle_deg: angles.1 as f64 / counts_per_deg,
-        error,
-    }
-}
 
 /// Where the bytes come from.
 enum Source {

@@ -13,7 +13,7 @@ use crate::data::run_file::{Column, Series as RunSeries};
 use crate::data::source::Source;
 use crate::error::LabError;
 use crate::noise::analysis::{analyse, Allan};
-use crate::noise::gaps::{fill_gaps, Filled};
+use crate::noise::gaps::{fill_gaps_owned, Filled};
 use crate::noise::model::Interval;
 use crate::noise::record_checks;
 use crate::noise::terms::{self, shape_name, COUNT, MARKOV_NAME, NAMES, SIN_NAME, UNITS};
@@ -83,7 +83,12 @@ pub fn allan(source: Source, column: &str, spec: &ReadSpec) -> Result<AllanOutco
         &series.t_s,
         &series.values,
     ));
-    let filled = fill_gaps(&series.t_s, &series.values)
+    let values = std::mem::take(&mut series.values);
+    // The median interval the checks found, where they kept every row and
+    // moved none (a uniform record).
+    let median = (warm_up.is_none() && checked.sampling.kind == "uniform")
+        .then_some(checked.sampling.period_s);
+    let filled = fill_gaps_owned(&series.t_s, values, median)
         .map_err(|e| series.time_error(e.row(), e.to_string()))?;
     let an = analyse(&filled.values, filled.tau0)
         .map_err(|e| source.origin().whole(format!("column `{analysed}`: {e}")))?;

@@ -16,7 +16,7 @@ pub const KINDS: &str =
 pub enum CoeffSet {
     /// RLG thermal coefficients, with the temperatures the fit saw.
     RlgThermal(ThermalCoeffs, Option<CalibratedRange>),
-    FogScaleFactor(ScaleFactorTable),
+    FogScaleFactor(Box<ScaleFactorTable>),
     /// A model from `discover`.
     Model(Box<ModelFile>, GyroKind),
 }
@@ -44,7 +44,7 @@ pub fn read_coeffs(text: &str, name: &str) -> Result<CoeffSet, LabError> {
     })?;
     Ok(match coeffs {
         Coeffs::RlgThermal(c) => CoeffSet::RlgThermal(c, file.fit.as_ref().and_then(thermal_range)),
-        Coeffs::FogScaleFactor(t) => CoeffSet::FogScaleFactor(t),
+        Coeffs::FogScaleFactor(t) => CoeffSet::FogScaleFactor(Box::new(t)),
     })
 }
 

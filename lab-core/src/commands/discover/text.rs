@@ -157,7 +157,7 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
             out.push(format!("  it follows most: {}", c.join(", ")));
         }
         None if d.found.is_empty() && d.ambiguous.is_empty() && d.terms.is_empty() => {
-            out.push(format!("nothing is missing: no effect of the library beats the noise, and nothing stands out of it"));
+            out.push("nothing is missing: no effect of the library beats the noise, and nothing stands out of it".to_string());
         }
         None => {}
     }
