@@ -54,7 +54,7 @@ use gyro_fw::app::{
     fog_params, FramePath, FrameQueue, RlgQueue, CLOSURES_PER_FRAME, CLOSURE_HZ, FOG_SF_RECORD,
     RLG_HZ, RLG_RECORD, SAMPLES_PER_HALF, SENSOR_EVERY,
 };
-use gyro_fw::overrun::{judge, DmaState};
+use gyro_fw::overrun::judge;
 use gyro_fw::{stack, uart};
 use gyro_sim::rlg_dither_rig::{qemu_dither_params, LATCH_CLOCK_HZ};
 use gyro_sim::{
@@ -67,6 +67,14 @@ use gyro_sp::rlg::thermal::{Temperatures, ThermalConfig};
 use gyro_sp::rlg::{LatchSample, RlgChannel, RlgConfig, StripConfig};
 use heapless::spsc::{Consumer, Producer};
 use tmp117::Tmp117;
+
+mod bench;
+mod sim_i2c;
+mod virtual_dma;
+
+use bench::{ticks_between, Bench, ClosureBenches};
+use sim_i2c::SimI2c;
+use virtual_dma::VirtualDma;
 
 /// SysTick clock of the emulated STM32F405 (QEMU's SYSCLK).
 const CORE_HZ: u32 = 168_000_000;
@@ -106,49 +114,6 @@ static CLOSURES: AtomicU32 = AtomicU32::new(0);
 const RLG_LEAD: u32 = 12;
 /// Closures before the frame's end at which the closure starts it itself.
 const RLG_LAST_START: u32 = 6;
-
-/// Simulated TMP117s on one I2C bus: they answer temperature reads with the
-/// chamber's readings; one address can be made to NACK.
-struct SimI2c {
-    /// 0x48 monoblock A, 0x49 monoblock B, 0x4A case, 0x4B FOG coil.
-    temps_c: [f64; 4],
-    nack: Option<u8>,
-}
-
-impl SimI2c {
-    fn new() -> Self {
-        Self {
-            temps_c: [20.0; 4],
-            nack: None,
-        }
-    }
-}
-
-impl embedded_hal::i2c::ErrorType for SimI2c {
-    type Error = embedded_hal::i2c::ErrorKind;
-}
-
-impl embedded_hal::i2c::I2c for SimI2c {
-    fn transaction(
-        &mut self,
-        address: u8,
-        operations: &mut [embedded_hal::i2c::Operation<'_>],
-    ) -> Result<(), Self::Error> {
-        let i = match address {
-            0x48..=0x4B if self.nack != Some(address) => (address - 0x48) as usize,
-            _ => return Err(tmp117::NACK_ADDRESS),
-        };
-        let reg = ((self.temps_c[i] * 128.0) as i16).to_be_bytes();
-        for op in operations {
-            if let embedded_hal::i2c::Operation::Read(buf) = op {
-                for (b, r) in buf.iter_mut().zip(reg) {
-                    *b = r;
-                }
-            }
-        }
-        Ok(())
-    }
-}
 
 /// One update of the recorded dithered gyro: the encoder counter at the
 /// update's instant (latch clock ticks), the end of its crossings in
@@ -194,131 +159,6 @@ pub struct FogThermal {
 /// Coil temperature at closure time `t_s`, degC.
 fn coil_at(t_s: f64) -> f64 {
     COIL_START_C + COIL_RATE_C_PER_S * t_s
-}
-
-/// The hw board's ADC DMA ping-pong, simulated: one half completes at
-/// every SysTick wrap (the closure's period), the first half first. It says
-/// what the DMA's flags and NDTR would read when the closure enters, and
-/// the periods between completions by a cycle counter (TIM2, free-running
-/// on QEMU's virtual clock), as the hw board's cycle counter gives them.
-/// A completion's time is the entry's less SysTick's count since its wrap.
-/// QEMU's virtual clock is only faithful while the CPU runs: in WFI it
-/// follows the host's clock and SysTick's count is skewed after the wake.
-/// But an interrupt that wakes an idle CPU was held off by nothing, so such
-/// an entry is one period, and its own time is the completion.
-pub struct VirtualDma {
-    /// TIM2 ticks per SysTick tick (measured at start).
-    tim2_per_tick: f32,
-    /// TIM2 count of the last completion seen, and completions seen.
-    last: u32,
-    completions: u64,
-}
-
-impl VirtualDma {
-    fn new(tim2_per_tick: f32, now: u32) -> Self {
-        Self {
-            tim2_per_tick,
-            last: now,
-            completions: 0,
-        }
-    }
-
-    /// The DMA registers at TIM2 count `now`, SysTick's count `current`
-    /// and whether the CPU was asleep, and the periods since the last
-    /// completion seen.
-    fn read(&mut self, now: u32, current: u32, woke: bool) -> (DmaState, u32) {
-        let since_wrap = if woke {
-            0
-        } else {
-            RELOAD.saturating_sub(current)
-        };
-        let completed = now.wrapping_sub((since_wrap as f32 * self.tim2_per_tick) as u32);
-        let period = (RELOAD + 1) as f32 * self.tim2_per_tick;
-        let periods = if woke {
-            1
-        } else {
-            // An interrupt means at least one completion.
-            ((completed.wrapping_sub(self.last) as f32 / period + 0.5) as u32).max(1)
-        };
-        self.last = completed;
-        self.completions += periods as u64;
-        let c = ADC_PER_CLOSURE as u32;
-        let into_half = since_wrap * c / (RELOAD + 1);
-        // Completion k (from 1): odd fills the first half, even the second;
-        // the DMA then writes the other.
-        let last_first = self.completions % 2 == 1;
-        let written = if last_first { c + into_half } else { into_half };
-        let state = DmaState {
-            half_done: periods >= 2 || (periods == 1 && last_first),
-            full_done: periods >= 2 || (periods == 1 && !last_first),
-            error: false,
-            remaining: (2 * c - written) as u16,
-        };
-        (state, periods)
-    }
-}
-
-/// SysTick ticks of timed sections: mean and worst.
-#[derive(Clone, Copy, Default)]
-pub struct Bench {
-    ticks_sum: u64,
-    ticks_max: u32,
-    n: u32,
-}
-
-impl Bench {
-    /// One timed section between two SysTick reads.
-    fn record(&mut self, t0: u32, t1: u32) {
-        self.add(ticks_between(t0, t1));
-    }
-
-    fn add(&mut self, ticks: u32) {
-        self.ticks_sum += ticks as u64;
-        self.ticks_max = self.ticks_max.max(ticks);
-        self.n += 1;
-    }
-
-    /// (mean, max) in instructions.
-    fn instructions(&self, ipt: f32) -> (u32, u32) {
-        (
-            (self.ticks_sum as f32 / self.n.max(1) as f32 * ipt) as u32,
-            (self.ticks_max as f32 * ipt) as u32,
-        )
-    }
-}
-
-/// SysTick ticks from reading `t0` to reading `t1`: it counts down and
-/// reloads at 0, so a reload in between adds RELOAD + 1.
-fn ticks_between(t0: u32, t1: u32) -> u32 {
-    if t1 <= t0 {
-        t0 - t1
-    } else {
-        t0 + RELOAD + 1 - t1
-    }
-}
-
-/// What the closure task measures.
-#[derive(Clone, Copy, Default)]
-pub struct ClosureBenches {
-    /// The closure step (the FOG core alone).
-    core: Bench,
-    /// Scale-factor table per frame and per coil reading.
-    sf_frame: Bench,
-    sf_sensor: Bench,
-    /// The overrun check (`overrun::judge` on the DMA's registers).
-    overrun_check: Bench,
-    /// Closures missed, and the closure at which the first was seen.
-    missed: u32,
-    missed_at: u32,
-    /// SysTick wrap (the interrupt raised) to the closure's last DAC word,
-    /// the simulated optics excluded: closures with the RLG update running
-    /// or pending at entry, and those that found the idle loop busy.
-    latency_under_rlg: Bench,
-    latency_alone: Bench,
-    /// Frames that ended without one RLG update's words (the update late),
-    /// and the first such frame.
-    rlg_late: u32,
-    rlg_late_at: u32,
 }
 
 #[rtic::app(device = stm32f4::stm32f405, peripherals = true)]
