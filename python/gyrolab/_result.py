@@ -13,8 +13,8 @@ def _is_number(x):
 
 
 def _arrays(v):
-    """JSON values with lists of numbers (and lists of such lists) as
-    float arrays (null as NaN); other values as they are."""
+    """JSON values with non-empty lists of numbers (and lists of such
+    lists) as float arrays (null as NaN); other values as they are."""
     if isinstance(v, dict):
         return {k: _arrays(x) for k, x in v.items()}
     if isinstance(v, list):
@@ -26,8 +26,7 @@ def _arrays(v):
             return np.array(
                 [[np.nan if y is None else y for y in x] for x in v], dtype=float
             )
-        if not v:
-            return np.array([], dtype=float)
+        # An empty list stays a list: `found == []` reads as nothing found.
         return [_arrays(x) for x in v]
     return v
 

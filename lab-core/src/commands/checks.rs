@@ -19,6 +19,9 @@ pub struct Checked {
     pub warnings: Vec<Warning>,
     pub sampling: Sampling,
     pub unit_basis: String,
+    /// The white noise of the rate less its reference, deg/s, where the
+    /// unit check measured it (on these rows).
+    pub white_sd_dps: Option<f64>,
     pub drifts: Vec<TempDrift>,
     spec: ReadSpec,
     rows: usize,
@@ -118,6 +121,7 @@ fn check(
         warnings,
         sampling,
         unit_basis: u.basis,
+        white_sd_dps: u.white_sd_dps,
         drifts,
         spec: spec.clone(),
         rows: t.len(),

@@ -204,7 +204,34 @@ pub fn median_mut(v: &mut [f64]) -> f64 {
         return f64::NAN;
     }
     let k = v.len() / 2;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
+    // Selected as integers: `f64::total_cmp`'s order is that of these
+    // keys, and integer compares partition about twice as fast (a 2e6-row
+    // record takes three medians in its checks). The map is its own
+    // inverse, so the values come back as they were, reordered.
+    let keys = total_order_keys(v);
+    let m = *keys.select_nth_unstable(k).1;
+    for x in keys.iter_mut() {
+        *x = total_order_key(*x);
+    }
+    f64::from_bits(total_order_key(m) as u64)
+}
+
+/// `x`'s bits as an integer in `f64::total_cmp`'s order (and back again).
+#[inline]
+fn total_order_key(b: i64) -> i64 {
+    b ^ ((((b >> 63) as u64) >> 1) as i64)
+}
+
+/// The values as their total-order keys, in place.
+fn total_order_keys(v: &mut [f64]) -> &mut [i64] {
+    // SAFETY: f64 and i64 have one size and alignment, and every bit
+    // pattern is a valid i64; the slice is borrowed mutably, so no f64
+    // view of it is alive while the keys are.
+    let keys = unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<i64>(), v.len()) };
+    for x in keys.iter_mut() {
+        *x = total_order_key(*x);
+    }
+    keys
 }
 
 #[cfg(test)]

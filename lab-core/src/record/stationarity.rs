@@ -117,6 +117,12 @@ pub fn warning(drifts: &[TempDrift]) -> Option<Warning> {
 /// stands more than [`RATE_SIGMAS`] standard errors of the white noise
 /// apart (deg/s in, the message in deg/h).
 pub fn mean_rate(t: &[f64], x: &[f64]) -> Option<Warning> {
+    mean_rate_with(t, x, None)
+}
+
+/// [`mean_rate`] with the white noise of `x` (`white_sd`, deg/s) where
+/// the caller has it already.
+pub fn mean_rate_with(t: &[f64], x: &[f64], white: Option<f64>) -> Option<Warning> {
     let n = x.len();
     if n < 200 {
         return None;
@@ -124,7 +130,7 @@ pub fn mean_rate(t: &[f64], x: &[f64]) -> Option<Warning> {
     let k = n / 10;
     let (first, _) = mean_sd(&x[..k]);
     let (rest, _) = mean_sd(&x[k..]);
-    let sd = white_sd(x);
+    let sd = white.unwrap_or_else(|| white_sd(x));
     let se = sd * (1.0 / k as f64 + 1.0 / (n - k) as f64).sqrt();
     let z = (first - rest).abs() / se.max(f64::MIN_POSITIVE);
     (z > RATE_SIGMAS).then(|| {

@@ -40,6 +40,9 @@ pub struct UnitCheck {
     pub warnings: Vec<Warning>,
     /// How the unit was confirmed, or why it could not be.
     pub basis: String,
+    /// The white noise of the rate less its reference (`white_sd`), deg/s,
+    /// where the check reached it: later checks of the same rows reuse it.
+    pub white_sd_dps: Option<f64>,
 }
 
 /// The units the file could be in instead, with the factor that turns
@@ -133,7 +136,7 @@ fn grid_step(x: &[f64]) -> Option<f64> {
             .map(|w| (w[1] - w[0]).abs())
             .filter(|v| *v > 0.0)
     };
-    let (n, q) = steps().fold((0usize, f64::INFINITY), |(n, q), v| (n + 1, q.min(v)));
+    let (n, q) = smallest_step(x);
     if n < 20 || q <= 0.0 {
         return None;
     }
@@ -149,6 +152,32 @@ fn grid_step(x: &[f64]) -> Option<f64> {
         }
     }
     Some(q)
+}
+
+/// The number of nonzero first differences of `x` and the smallest of
+/// them: branch-free over lanes, so the compiler vectorises it.
+fn smallest_step(x: &[f64]) -> (usize, f64) {
+    const L: usize = 8;
+    let (mut n, mut q) = ([0usize; L], [f64::INFINITY; L]);
+    let d = |i: usize| (x[i + 1] - x[i]).abs();
+    let m = x.len().saturating_sub(1);
+    let whole = m / L * L;
+    for i in (0..whole).step_by(L) {
+        for j in 0..L {
+            let v = d(i + j);
+            let nz = v > 0.0;
+            n[j] += nz as usize;
+            q[j] = q[j].min(if nz { v } else { f64::INFINITY });
+        }
+    }
+    for i in whole..m {
+        let v = d(i);
+        if v > 0.0 {
+            n[0] += 1;
+            q[0] = q[0].min(v);
+        }
+    }
+    (n.iter().sum(), q.iter().copied().fold(f64::INFINITY, f64::min))
 }
 
 /// Whether `v` is a round decimal (1, 2, 2.5 or 5 times a power of ten, or
@@ -269,6 +298,7 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
     };
     let (mean_bias, _) = mean_sd(&bias);
     let sd = white_sd(&bias);
+    out.white_sd_dps = Some(sd);
     // 4: a grid of round degrees that is not one of the unit read.
     if let Some(q) = grid_step(&bias) {
         if !round_decimal(q) {

@@ -79,9 +79,13 @@ pub fn allan(source: Source, column: &str, spec: &ReadSpec) -> Result<AllanOutco
         }
         None => column.to_owned(),
     };
-    warnings.extend(crate::record::stationarity::mean_rate(
+    // The unit check measured the white noise on these very rows unless a
+    // warm-up was cut since.
+    let white = checked.white_sd_dps.filter(|_| warm_up.is_none());
+    warnings.extend(crate::record::stationarity::mean_rate_with(
         &series.t_s,
         &series.values,
+        white,
     ));
     let values = std::mem::take(&mut series.values);
     // The median interval the checks found, where they kept every row and
