@@ -81,6 +81,9 @@ def test_runs_shipped_to_the_workers(fleet, client):
         assert not d, "\n".join(d[:20])
 
 
+# The module's cluster holds the dashboard's usual port; the example's own
+# cluster takes another.
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
 def test_example_as_a_program(fleet, capsys):
     ex = example()
     assert ex.main([str(fleet), "--gyro", "fog", "--workers", "2"]) == 0

@@ -5,6 +5,7 @@ mod bench_discover;
 mod capture;
 mod frames;
 mod panic_paths;
+mod python;
 mod record_test;
 mod setup;
 
@@ -26,8 +27,12 @@ fn main() {
         Some("isr-proof") => isr_proof_cmd(),
         // The README's lab walkthrough, top to bottom (part of `test`).
         Some("readme") => readme_cmd(),
+        // The Python package's pytest suite (part of `test`).
+        Some("python-test") => python_test_cmd(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu|test|bench|record-test|isr-proof|readme>");
+            eprintln!(
+                "usage: cargo xtask <qemu|test|bench|record-test|isr-proof|readme|python-test>"
+            );
             std::process::exit(2);
         }
     };
@@ -299,7 +304,16 @@ fn test_cmd() -> Result<()> {
         bail!("{failed} firmware test(s) under QEMU failed");
     }
     record_tests(&qrun)?;
+    // The Python package over the same code, against the command line
+    // (record_tests built it) and the QEMU run's capture.
+    python::test(&root().join("target/release/gyro-lab"))?;
     readme_cmd()
+}
+
+/// `cargo xtask python-test`: the Python package's suite alone.
+fn python_test_cmd() -> Result<()> {
+    run(cargo().args(["build", "--release", "-p", "gyro-lab"]))?;
+    python::test(&root().join("target/release/gyro-lab"))
 }
 
 /// `cargo xtask readme`: the README's "The lab, step by step", every
@@ -434,6 +448,7 @@ fn bench_cmd() -> Result<()> {
             .with_context(|| format!("no {k} from gyro-lab bench allan-speed"))
     };
     let discover = bench_discover::costs(&lab, &root().join("runs"))?;
+    let py = python::bench_allan()?;
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
         "fog_closure_instructions_max": grab("max")?,
@@ -459,6 +474,9 @@ fn bench_cmd() -> Result<()> {
     let mut j = j;
     if let (Some(o), Some(d)) = (j.as_object_mut(), discover.as_object()) {
         o.extend(d.clone());
+    }
+    if let (Some(o), Some(p)) = (j.as_object_mut(), py.as_object()) {
+        o.extend(p.clone());
     }
     println!("{j}");
     Ok(())

@@ -37,7 +37,7 @@ pub fn ensure_all() -> Result<()> {
     Ok(())
 }
 
-fn apt_install(package: &str) -> Result<()> {
+pub fn apt_install(package: &str) -> Result<()> {
     let sudo = if have("sudo") && !is_root() {
         "sudo "
     } else {

@@ -177,7 +177,10 @@ fn smallest_step(x: &[f64]) -> (usize, f64) {
             q[0] = q[0].min(v);
         }
     }
-    (n.iter().sum(), q.iter().copied().fold(f64::INFINITY, f64::min))
+    (
+        n.iter().sum(),
+        q.iter().copied().fold(f64::INFINITY, f64::min),
+    )
 }
 
 /// Whether `v` is a round decimal (1, 2, 2.5 or 5 times a power of ten, or
