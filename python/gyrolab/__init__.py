@@ -5,9 +5,9 @@ Each function runs what its command runs and answers with the same JSON
 keys, the same text and the same report::
 
     import gyrolab, pandas as pd
-    df = pd.read_csv("chamber.csv")
+    df = pd.read_csv("chamber.csv", comment="#")
     a = gyrolab.allan(df)                 # the rate's Allan deviation
-    a["adev_dph"], a.terms["bias_instability"]
+    a["adev_dph"], a.terms["bias_instability_dph"]
     a                                     # in a notebook: the report
     d = gyrolab.discover(df, gyro="fog")  # what the model misses
     d.found, d.gap_after_dph, d.model_toml
