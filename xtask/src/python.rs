@@ -60,6 +60,7 @@ pub fn test(gyro_lab: &std::path::Path) -> Result<()> {
             "-m",
             "pytest",
             "-q",
+            "-rs",
             "-p",
             "no:cacheprovider",
             "python/tests",
