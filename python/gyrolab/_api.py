@@ -2,13 +2,13 @@
 code through the native half (gyrolab._native) and answers as it does."""
 
 from . import _native
-from ._inputs import read_options, run_input, text_input, time_name
+from ._inputs import mapped, read_options, run_input, text_input, time_name
 from ._result import Result
 
 
-def _run(run, kw, label="run"):
+def _run(run, kw, label="run", also=()):
     opts = read_options(kw)
-    return run_input(run, label, time_name(opts)), opts
+    return run_input(run, label, time_name(opts), mapped(opts) + tuple(also)), opts
 
 
 def read_run(run, **read):
@@ -24,7 +24,7 @@ def allan(run, *, column="rate_dps", **read):
     """``gyro-lab allan``: overlapping Allan deviation of a rate column
     (less ``ref_rate_dps`` where the run has one), IEEE 952 terms with 95 %
     intervals, the fit checked, the readings off the curve."""
-    src, opts = _run(run, read)
+    src, opts = _run(run, read, also=(column,))
     return Result("allan", _native.allan(src, "run", column, opts))
 
 
@@ -36,7 +36,7 @@ def discover(run, *, gyro, model=None, grade=None, validate=None, **read):
     model written must predict."""
     src, opts = _run(run, read)
     m = text_input(model, "model") if model is not None else None
-    v = run_input(validate, "validate", time_name(opts)) if validate is not None else None
+    v = run_input(validate, "validate", time_name(opts), mapped(opts)) if validate is not None else None
     native, toml, residual = _native.discover(src, "run", gyro, m, grade, v, opts)
     return Result("discover", native, {"model_toml": toml, "residual": dict(residual)})
 
@@ -64,7 +64,7 @@ def compensate(coeffs, run, *, cubic_from=None, **read):
     the run as read with ``rate_comp_dps`` added."""
     src, opts = _run(run, read)
     c = text_input(coeffs, "coeffs")
-    cubic = run_input(cubic_from, "cubic_from", time_name(opts)) if cubic_from is not None else None
+    cubic = run_input(cubic_from, "cubic_from", time_name(opts), mapped(opts)) if cubic_from is not None else None
     native, cols = _native.compensate(c, src, "run", opts, cubic)
     return Result("compensate", native, {"run": dict(cols)})
 

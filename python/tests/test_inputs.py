@@ -132,3 +132,26 @@ def test_release_the_gil_for_threads(runs):
 def test_dicts_without_a_rate(bad):
     with pytest.raises(ValueError, match="missing column"):
         gyrolab.allan(bad)
+
+
+def test_what_a_users_dataframe_also_holds():
+    """A logger's frame: text timestamps under its own names, a serial
+    number and a comment column the command does not read (ignored, as a
+    file's other columns are), a time zone on the index."""
+    rng = np.random.default_rng(10)
+    n = 3600
+    r = rng.normal(0, 0.01, n)
+    ref = gyrolab.allan({"t_s": np.arange(n, dtype=float), "rate_dps": r})
+    stamps = pd.date_range("2026-03-01 14:00:00", periods=n, freq="1s")
+    text = stamps.strftime("%Y-%m-%d %H:%M:%S.%f").str[:-3]
+    log = pd.DataFrame({"time": text, "gyro_z": r, "serial": "FOG-0042", "note": ""})
+    a = gyrolab.allan(log, columns={"t_s": "time", "rate_dps": "gyro_z"})
+    np.testing.assert_allclose(a["adev_dph"], ref["adev_dph"], rtol=1e-12)
+    zoned = pd.DataFrame({"rate_dps": r}, index=stamps.tz_localize("Europe/Berlin"))
+    np.testing.assert_allclose(gyrolab.allan(zoned)["adev_dph"], ref["adev_dph"], rtol=1e-12)
+    # A column the command reads is kept whatever it holds: its error names it.
+    with pytest.raises(ValueError, match=r"column `time`\): dtype object"):
+        gyrolab.allan(log.assign(time="x"), columns={"t_s": "time", "rate_dps": "gyro_z"})
+    # allan's `column` may name any column: kept, and checked.
+    with pytest.raises(ValueError, match=r"column `serial`"):
+        gyrolab.allan(log, columns={"t_s": "time", "rate_dps": "gyro_z"}, column="serial")
