@@ -291,3 +291,57 @@ fn coloured_noise_gets_no_term() {
         assert!(terms.is_empty(), "seed {seed}: {v}");
     }
 }
+
+/// A jump that relaxes (a relock, a heater's transient) on a FOG chamber
+/// run: the noise model first takes it as a random walk beyond any
+/// navigation gyro's, under which it predicts nothing, and a smooth
+/// settling that misses the jump itself fails the checks. Looked at
+/// under the grade's noise, with its onset refined off the coarse grid,
+/// the event is proposed with its truth inside its intervals, and the gap
+/// falls to the floor.
+#[test]
+fn a_jump_that_relaxes_is_found_where_a_random_walk_took_it() {
+    let d = common::dir("model-term-jump-relax");
+    let truth = d.join("truth.toml");
+    let formula = "k_dph * step(t_s - t0_s) * exp(-(t_s - t0_s) * step(t_s - t0_s) / tau_s)";
+    std::fs::write(
+        &truth,
+        term_model(formula, "k_dph = 2.0\nt0_s = 5000.0\ntau_s = 900.0"),
+    )
+    .unwrap();
+    let run = d.join("run.csv");
+    let (m, o) = (p(&truth), p(&run));
+    lab_ok(&[
+        "simulate",
+        "run",
+        "--model",
+        &m,
+        "--profile",
+        "fog-chamber",
+        "--out",
+        &o,
+    ]);
+    let v = discover(None, &run, &d.join("o"), &[]);
+    // A proposed term is among what was found (model_terms are a user's).
+    let found = v["found"].as_array().unwrap();
+    let t = found
+        .iter()
+        .find(|t| t["formula"] == formula)
+        .unwrap_or_else(|| panic!("no relaxing jump proposed: {}", v["proposal"]));
+    for (name, want) in [("k_dph", 2.0), ("t0_s", 5000.0), ("tau_s", 900.0)] {
+        let iv = &t["parameter_intervals"][name];
+        let (lo, hi) = (iv[0].as_f64().unwrap(), iv[1].as_f64().unwrap());
+        assert!(
+            lo <= want && want <= hi,
+            "{name}: {want} outside [{lo}, {hi}]: {t}"
+        );
+    }
+    let (after, floor) = (
+        v["gap_after_dph"].as_f64().unwrap(),
+        v["noise_floor_dph"].as_f64().unwrap(),
+    );
+    assert!(
+        after < 1.1 * floor,
+        "gap {after} against a floor of {floor}"
+    );
+}

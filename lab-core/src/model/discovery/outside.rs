@@ -9,7 +9,7 @@
 //! A proposal is kept only where the gap after shrinks with it; the gap
 //! before stays the model given's.
 
-use super::noise_model::Whitener;
+use super::noise_model::{NoiseModel, Whitener};
 use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
 use super::select::Implausible;
 use crate::model::effects::Effect;
@@ -50,8 +50,12 @@ struct Rows<'a> {
 
 impl<'a> Rows<'a> {
     fn new(d: &'a Discovery) -> Self {
+        Self::with_noise(d, &d.noise)
+    }
+    /// Whitened under another noise model than the one `d` fitted.
+    fn with_noise(d: &'a Discovery, noise: &NoiseModel) -> Self {
         Self {
-            wh: Whitener::new(&d.noise, &d.windows, &d.keep),
+            wh: Whitener::new(noise, &d.windows, &d.keep),
             d,
         }
     }
@@ -290,57 +294,82 @@ pub fn beyond(
             ));
             break;
         }
-        let rows = Rows::new(&cur);
-        let y = rows.dps(&cur.residual_after);
-        let fit = fit_columns(given, &cur, inp, &rows, None);
-        let p = propose(inp, &y, &fit, &|x| rows.dph(x), &cur.windows, &|xs| {
-            rows.windows_dph(xs)
-        });
-        log.tried = p.tried;
-        log.space = p.space;
-        log.threshold = p.threshold;
-        let Some(pr) = p.proposed else {
-            log.note = Some(match log.tried.first() {
-                Some(b) => format!(
-                    "no term built from the run's inputs predicts what is left on data it was not fitted on: the best, {} ({}), gains {:.1} noise variances out of sample, below the {} the candidate space's false alarms ask",
-                    b.label, b.formula, b.held_out_gain, p.threshold
-                ),
-                None => "the run's inputs give no candidate term".into(),
+        // First under the noise the discovery fitted; then, where that
+        // gives no term the checks below accept, a second look under the
+        // grade's noise: where the noise model fitted slow levels beyond
+        // any gyro of this grade's (the floor's caps), they may have taken
+        // an event of the record as noise (a random walk explains a jump
+        // as well as the jump does), and whitened by them the event
+        // predicts nothing. A term found there must pass the same checks:
+        // it closes most of what stands above the floor, with the
+        // library's effects fitted again beside it.
+        let capped = cur.noise.capped(cur.grade.value.noise_caps());
+        let looks: &[&NoiseModel] = if capped == cur.noise {
+            &[&cur.noise]
+        } else {
+            &[&cur.noise, &capped]
+        };
+        let mut accepted = None;
+        for noise in looks {
+            let rows = Rows::with_noise(&cur, noise);
+            let y = rows.dps(&cur.residual_after);
+            let fit = fit_columns(given, &cur, inp, &rows, None);
+            let p = propose(inp, &y, &fit, &|x| rows.dph(x), &cur.windows, &|xs| {
+                rows.windows_dph(xs)
             });
+            log.tried = p.tried;
+            log.space = p.space;
+            log.threshold = p.threshold;
+            let Some(pr) = p.proposed else {
+                log.note = Some(match log.tried.first() {
+                    Some(b) => format!(
+                        "no term built from the run's inputs predicts what is left on data it was not fitted on: the best, {} ({}), gains {:.1} noise variances out of sample, below the {} the candidate space's false alarms ask",
+                        b.label, b.formula, b.held_out_gain, p.threshold
+                    ),
+                    None => "the run's inputs give no candidate term".into(),
+                });
+                continue;
+            };
+            let mut m2 = m.clone();
+            m2.terms.push(pr.term.clone());
+            let next = discover_library(&m2, run, opts);
+            // What stood above the floor, and what of it the term closed:
+            // a term that predicts a little of a residual it cannot
+            // explain (a slow wander the noise model misread) is not the
+            // missing effect.
+            let floor = cur.noise_floor_dph.min(next.noise_floor_dph);
+            let excess = |g: f64| (g * g - floor * floor).max(0.0);
+            let closed = 1.0 - excess(next.gap_after_dph) / excess(cur.gap_after_dph).max(1e-300);
+            if next.gap_after_dph < cur.gap_after_dph && closed < MIN_CLOSED {
+                log.note = Some(format!(
+                    "{} ({}) predicted blocks of the record it was not fitted on, but closed only {:.0} % of what stood above the noise floor ({:.4} -> {:.4} deg/h, floor {:.4}), less than the {:.0} % that makes it the missing effect: not added",
+                    pr.label,
+                    pr.term.formula,
+                    100.0 * closed,
+                    cur.gap_after_dph,
+                    next.gap_after_dph,
+                    floor,
+                    100.0 * MIN_CLOSED
+                ));
+                continue;
+            }
+            if next.gap_after_dph >= cur.gap_after_dph {
+                log.note = Some(format!(
+                    "{} ({}) predicted blocks of the record it was not fitted on, but with the library's effects fitted again beside it the gap after did not shrink ({:.4} -> {:.4} deg/h): not added",
+                    pr.label,
+                    pr.term.formula,
+                    cur.gap_after_dph,
+                    next.gap_after_dph
+                ));
+                continue;
+            }
+            log.note = None;
+            accepted = Some((pr, m2, next, closed));
+            break;
+        }
+        let Some((pr, m2, next, closed)) = accepted else {
             break;
         };
-        let mut m2 = m.clone();
-        m2.terms.push(pr.term.clone());
-        let next = discover_library(&m2, run, opts);
-        // What stood above the floor, and what of it the term closed: a
-        // term that predicts a little of a residual it cannot explain (a
-        // slow wander the noise model misread) is not the missing effect.
-        let floor = cur.noise_floor_dph.min(next.noise_floor_dph);
-        let excess = |g: f64| (g * g - floor * floor).max(0.0);
-        let closed = 1.0 - excess(next.gap_after_dph) / excess(cur.gap_after_dph).max(1e-300);
-        if next.gap_after_dph < cur.gap_after_dph && closed < MIN_CLOSED {
-            log.note = Some(format!(
-                "{} ({}) predicted blocks of the record it was not fitted on, but closed only {:.0} % of what stood above the noise floor ({:.4} -> {:.4} deg/h, floor {:.4}), less than the {:.0} % that makes it the missing effect: not added",
-                pr.label,
-                pr.term.formula,
-                100.0 * closed,
-                cur.gap_after_dph,
-                next.gap_after_dph,
-                floor,
-                100.0 * MIN_CLOSED
-            ));
-            break;
-        }
-        if next.gap_after_dph >= cur.gap_after_dph {
-            log.note = Some(format!(
-                "{} ({}) predicted blocks of the record it was not fitted on, but with the library's effects fitted again beside it the gap after did not shrink ({:.4} -> {:.4} deg/h): not added",
-                pr.label,
-                pr.term.formula,
-                cur.gap_after_dph,
-                next.gap_after_dph
-            ));
-            break;
-        }
         closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
         proposed.push((pr.label.clone(), pr.intervals, pr.validation));
         (m, cur) = (m2, next);

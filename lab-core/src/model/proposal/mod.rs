@@ -235,6 +235,19 @@ pub fn propose(
     let coarse = |s: &Scored| grid_red(s) / var - pen * cost(&s.0);
     finalists.sort_by(|a, b| coarse(b).total_cmp(&coarse(a)));
     finalists.truncate(FINALISTS);
+    // The events searched in two parameters that pass the threshold join
+    // them, the best two by gain, however far behind: on the coarse grid
+    // an onset a grid spacing off the event's costs it most of its gain
+    // where the noise model whitens by differences (a random walk), while
+    // a smooth shape that misses the jump itself does not pay that, and
+    // only the refinement (jointly) puts the onset where it belongs.
+    let mut events: Vec<&Scored> = scored
+        .iter()
+        .filter(|s| s.0.searched.len() == 2 && s.3 / var >= thr)
+        .filter(|s| !finalists.iter().any(|f| std::ptr::eq(*f, *s)))
+        .collect();
+    events.truncate(2);
+    finalists.extend(events);
     let fitted = |s: &Scored| {
         if s.0.searched.len() > 1 {
             jointly(s, inp, y, fit, to_rows, var)
@@ -391,7 +404,44 @@ fn jointly(
     to_rows: ToRows,
     var: f64,
 ) -> Option<Fitted> {
-    let (c, grid, kept, _, _) = s;
+    let (c, coarse_grid, coarse_kept, _, _) = s;
+    let q = basis(fit);
+    // Each searched parameter refined between its coarse grid's
+    // neighbours of the best, the other held, twice round: Gauss-Newton
+    // alone cannot move an onset (its derivative is a step's), and a jump
+    // placed a grid spacing off loses to a plain step refined on_grid.
+    let mut grid = coarse_grid.clone();
+    let mut kept = coarse_kept.clone();
+    if let Some((b, _, mut best)) = best_fit(&grid) {
+        let mut at = kept[b].clone();
+        for _ in 0..2 {
+            for d in 0..at.len() {
+                let mut values: Vec<f64> = coarse_kept.iter().map(|p| p[d]).collect();
+                values.sort_by(f64::total_cmp);
+                values.dedup();
+                let k = values.partition_point(|&v| v < at[d]);
+                let lo = values[k.saturating_sub(1)];
+                let hi = values[(k + 1).min(values.len() - 1)];
+                for j in 1..REFINE {
+                    let mut p = at.clone();
+                    p[d] = lo + (hi - lo) * j as f64 / REFINE as f64;
+                    let Some(cols) = columns(c, &p, inp, to_rows, &q) else {
+                        continue;
+                    };
+                    let st = stats(&cols, y, FOLDS);
+                    if let Some((_, r)) = st.fit(None) {
+                        if r > best {
+                            best = r;
+                            at = p.clone();
+                        }
+                    }
+                    grid.push(st);
+                    kept.push(p);
+                }
+            }
+        }
+    }
+    let (grid, kept) = (&grid, &kept);
     let fits: Vec<(usize, Vec<f64>, f64)> = grid
         .iter()
         .enumerate()
@@ -410,7 +460,6 @@ fn jointly(
     let start = Term::new(&c.formula(), params).ok()?;
     let free: Vec<String> = start.params.keys().cloned().collect();
     // The reduction of the sum of squares a term's values make.
-    let q = basis(fit);
     let yq = orthogonal(y.to_vec(), &q);
     let reduction = |t: &Term| -> Option<f64> {
         let g = orthogonal(to_rows(&t.evaluate(inp).ok()?), &q);
