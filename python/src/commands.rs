@@ -10,7 +10,9 @@ use gyro_lab_core::commands::{
     fit_scale_factor as sf_cmd, fit_thermal as thermal_cmd, frames, lockin as lockin_cmd,
     model_file, simulate_run as simulate_cmd,
 };
+use gyro_lab_core::data::read_spec::ReadSpec;
 use gyro_lab_core::data::run_file::{Column, Reference, RunFile};
+use gyro_lab_core::data::source::Source;
 use gyro_lab_core::error::LabError;
 use gyro_lab_core::model::grade::Grade;
 use gyro_lab_core::model::gyro_kind::GyroKind;
@@ -29,6 +31,22 @@ fn named_arrays<'py>(py: Python<'py>, cols: Vec<(String, Vec<f64>)>) -> Arrays<'
         .collect()
 }
 
+/// A command on one run: the run and the reading options taken from
+/// Python as the command line takes its file and options, then `f` on
+/// them with the GIL released and no panic let through.
+fn on_run<T: Send>(
+    py: Python<'_>,
+    run: &Bound<'_, PyAny>,
+    label: &str,
+    read: Option<&Bound<'_, PyDict>>,
+    f: impl FnOnce(Source<'_>, &ReadSpec) -> Result<T, LabError> + Send,
+) -> PyResult<T> {
+    let held = RunIn::new(run, label)?;
+    let run = held.prepare()?;
+    let read = ReadIn::from_dict(read)?;
+    detached(py, || f(run.source(), &read.spec()?))
+}
+
 /// The columns of a run file, by name (those the run has).
 #[pyfunction]
 #[pyo3(signature = (run, label, read=None))]
@@ -38,16 +56,12 @@ pub fn read_run<'py>(
     label: &str,
     read: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Arrays<'py>> {
-    let held = RunIn::new(run, label)?;
-    let run = held.prepare()?;
-    let read = ReadIn::from_dict(read)?;
-    let cols = detached(py, || {
-        let spec = read.spec()?;
+    let cols = on_run(py, run, label, read, |source, spec| {
         let optional: Vec<Column> = Column::ALL
             .into_iter()
             .filter(|c| !c.required() && *c != Column::RefRate)
             .collect();
-        let r = RunFile::read_long(run.source(), &spec, Reference::ZeroIfAbsent, 1, &optional)?;
+        let r = RunFile::read_long(source, spec, Reference::ZeroIfAbsent, 1, &optional)?;
         let mut out = vec![(Column::Time.name().to_owned(), r.t_s.clone())];
         if r.has_reference {
             out.push((Column::RefRate.name().to_owned(), r.ref_rate_dps.clone()));
@@ -73,12 +87,8 @@ pub fn allan(
     column: &str,
     read: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Native> {
-    let held = RunIn::new(run, label)?;
-    let run = held.prepare()?;
-    let read = ReadIn::from_dict(read)?;
-    detached(py, || {
-        let spec = read.spec()?;
-        let o = allan_cmd::allan(run.source(), column, &spec)?;
+    on_run(py, run, label, read, |source, spec| {
+        let o = allan_cmd::allan(source, column, spec)?;
         let (json, text, summary) = (o.json(), o.text(None), o.summary());
         Ok(Native::new(
             &json,
@@ -187,12 +197,8 @@ pub fn fit_thermal(
     label: &str,
     read: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(Native, String)> {
-    let held = RunIn::new(run, label)?;
-    let run = held.prepare()?;
-    let read = ReadIn::from_dict(read)?;
-    detached(py, || {
-        let spec = read.spec()?;
-        thermal_cmd::fit_thermal(run.source(), &spec, true).map(fit)
+    on_run(py, run, label, read, |source, spec| {
+        thermal_cmd::fit_thermal(source, spec, true).map(fit)
     })
 }
 
@@ -205,12 +211,8 @@ pub fn fit_scale_factor(
     label: &str,
     read: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(Native, String)> {
-    let held = RunIn::new(run, label)?;
-    let run = held.prepare()?;
-    let read = ReadIn::from_dict(read)?;
-    detached(py, || {
-        let spec = read.spec()?;
-        sf_cmd::fit_scale_factor(run.source(), &spec, true).map(fit)
+    on_run(py, run, label, read, |source, spec| {
+        sf_cmd::fit_scale_factor(source, spec, true).map(fit)
     })
 }
 
@@ -291,12 +293,8 @@ pub fn lockin(
     input_rate_dps: Option<f64>,
     read: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Native> {
-    let held = RunIn::new(fringe, label)?;
-    let run = held.prepare()?;
-    let read = ReadIn::from_dict(read)?;
-    detached(py, || {
-        let spec = read.spec()?;
-        let o = lockin_cmd::lockin(run.source(), &spec, pulses_per_deg, input_rate_dps, true)?;
+    on_run(py, fringe, label, read, |source, spec| {
+        let o = lockin_cmd::lockin(source, spec, pulses_per_deg, input_rate_dps, true)?;
         let summary = o
             .text
             .iter()
