@@ -295,6 +295,38 @@ fn best_fit(grid: &[BlockStats]) -> Option<(usize, Vec<f64>, f64)> {
         .max_by(|a, b| a.2.total_cmp(&b.2))
 }
 
+/// Searched parameter `d` of candidate `c` tried at REFINE - 1 points
+/// strictly between `lo` and `hi`, the others held at `at`: each point's
+/// statistics added to `grid` and `kept`, and the best point's reduction
+/// of the sum of squares and its parameters returned.
+fn refine_along(
+    c: &Candidate,
+    at: &[f64],
+    d: usize,
+    (lo, hi): (f64, f64),
+    (inp, y, to_rows, q): (&Inputs, &[f64], ToRows, &[Vec<f64>]),
+    grid: &mut Vec<BlockStats>,
+    kept: &mut Vec<Vec<f64>>,
+) -> Option<(f64, Vec<f64>)> {
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for j in 1..REFINE {
+        let mut p = at.to_vec();
+        p[d] = lo + (hi - lo) * j as f64 / REFINE as f64;
+        let Some(cols) = columns(c, &p, inp, to_rows, q) else {
+            continue;
+        };
+        let st = stats(&cols, y, FOLDS);
+        if let Some((_, r)) = st.fit(None) {
+            if best.as_ref().is_none_or(|b| r > b.0) {
+                best = Some((r, p.clone()));
+            }
+        }
+        grid.push(st);
+        kept.push(p);
+    }
+    best
+}
+
 /// A candidate with at most one searched parameter, fitted on its grid:
 /// the parameter refined between the coarse grid's neighbours of its best
 /// value, so its value and profile interval are not the grid's; the
@@ -314,13 +346,16 @@ fn on_grid(
     if let (Some(b), false) = (coarse_best, c.searched.is_empty()) {
         let lo = kept[b.saturating_sub(1)][0];
         let hi = kept[(b + 1).min(kept.len() - 1)][0];
-        for k in 1..REFINE {
-            let v = lo + (hi - lo) * k as f64 / REFINE as f64;
-            if let Some(cols) = columns(c, &[v], inp, to_rows, q) {
-                grid.push(stats(&cols, y, FOLDS));
-                kept.push(vec![v]);
-            }
-        }
+        let at = [kept[b][0]];
+        refine_along(
+            c,
+            &at,
+            0,
+            (lo, hi),
+            (inp, y, to_rows, q),
+            &mut grid,
+            &mut kept,
+        );
     }
     let fits: Vec<(usize, Vec<f64>, f64)> = grid
         .iter()
@@ -422,21 +457,14 @@ fn jointly(
                 let k = values.partition_point(|&v| v < at[d]);
                 let lo = values[k.saturating_sub(1)];
                 let hi = values[(k + 1).min(values.len() - 1)];
-                for j in 1..REFINE {
-                    let mut p = at.clone();
-                    p[d] = lo + (hi - lo) * j as f64 / REFINE as f64;
-                    let Some(cols) = columns(c, &p, inp, to_rows, &q) else {
-                        continue;
-                    };
-                    let st = stats(&cols, y, FOLDS);
-                    if let Some((_, r)) = st.fit(None) {
-                        if r > best {
-                            best = r;
-                            at = p.clone();
-                        }
+                let span = (lo, hi);
+                if let Some((r, p)) =
+                    refine_along(c, &at, d, span, (inp, y, to_rows, &q), &mut grid, &mut kept)
+                {
+                    if r > best {
+                        best = r;
+                        at = p;
                     }
-                    grid.push(st);
-                    kept.push(p);
                 }
             }
         }
