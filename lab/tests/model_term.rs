@@ -345,3 +345,55 @@ fn a_jump_that_relaxes_is_found_where_a_random_walk_took_it() {
         "gap {after} against a floor of {floor}"
     );
 }
+
+/// A pulse (a heater on for ten minutes) whose edges fall between the
+/// coarse grid's: a wider pulse on the grid fits as well wherever it
+/// covers the truth, so the onset, refined with the width held, had
+/// nowhere better to go. Refined with its end held, then the width, each
+/// edge is the truth's, inside its interval, and the gap falls to the
+/// floor.
+#[test]
+fn a_pulse_between_the_grid_points_is_found_edge_by_edge() {
+    let d = common::dir("model-term-pulse");
+    let truth = d.join("truth.toml");
+    let formula = "k_dph * (step(t_s - t0_s) - step(t_s - t0_s - w_s))";
+    std::fs::write(
+        &truth,
+        term_model(formula, "k_dph = -1.5\nt0_s = 4777.0\nw_s = 622.0"),
+    )
+    .unwrap();
+    let run = d.join("run.csv");
+    let (m, o) = (p(&truth), p(&run));
+    lab_ok(&[
+        "simulate",
+        "run",
+        "--model",
+        &m,
+        "--profile",
+        "fog-chamber",
+        "--out",
+        &o,
+    ]);
+    let v = discover(None, &run, &d.join("o"), &[]);
+    let found = v["found"].as_array().unwrap();
+    let t = found
+        .iter()
+        .find(|t| t["formula"] == formula)
+        .unwrap_or_else(|| panic!("no pulse proposed: {}", v["proposal"]));
+    for (name, want) in [("k_dph", -1.5), ("t0_s", 4777.0), ("w_s", 622.0)] {
+        let iv = &t["parameter_intervals"][name];
+        let (lo, hi) = (iv[0].as_f64().unwrap(), iv[1].as_f64().unwrap());
+        assert!(
+            lo <= want && want <= hi,
+            "{name}: {want} outside [{lo}, {hi}]: {t}"
+        );
+    }
+    let (after, floor) = (
+        v["gap_after_dph"].as_f64().unwrap(),
+        v["noise_floor_dph"].as_f64().unwrap(),
+    );
+    assert!(
+        after < 1.1 * floor,
+        "gap {after} against a floor of {floor}"
+    );
+}

@@ -449,6 +449,7 @@ fn bench_cmd() -> Result<()> {
     };
     let discover = bench_discover::costs(&lab, &root().join("runs"))?;
     let py = python::bench_allan()?;
+    let d2t = python::bench_d2t(&lab)?;
     let j = serde_json::json!({
         "fog_closure_instructions": instr,
         "fog_closure_instructions_max": grab("max")?,
@@ -475,8 +476,10 @@ fn bench_cmd() -> Result<()> {
     if let (Some(o), Some(d)) = (j.as_object_mut(), discover.as_object()) {
         o.extend(d.clone());
     }
-    if let (Some(o), Some(p)) = (j.as_object_mut(), py.as_object()) {
-        o.extend(p.clone());
+    for extra in [&py, &d2t] {
+        if let (Some(o), Some(p)) = (j.as_object_mut(), extra.as_object()) {
+            o.extend(p.clone());
+        }
     }
     println!("{j}");
     Ok(())

@@ -90,3 +90,31 @@ pub fn bench_allan() -> Result<serde_json::Value> {
     }
     Ok(serde_json::from_str(text.lines().last().unwrap_or("{}"))?)
 }
+
+/// The curvature bound (instruments/d2t_bound/bound.py) beside what
+/// `discover` reaches on the same chamber runs: one key per case.
+pub fn bench_d2t(lab: &std::path::Path) -> Result<serde_json::Value> {
+    install()?;
+    let work = root().join("runs/d2t");
+    let out = Command::new(python())
+        .arg(root().join("instruments/d2t_bound/bound.py"))
+        .arg("--lab")
+        .arg(lab)
+        .arg("--work")
+        .arg(&work)
+        .arg("--json")
+        .current_dir(root())
+        .output()?;
+    if !out.status.success() {
+        bail!(
+            "instruments/d2t_bound/bound.py failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut v: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or("{}"))?;
+    if let Some(o) = v.as_object_mut() {
+        o.remove("d2t_rows");
+    }
+    Ok(v)
+}

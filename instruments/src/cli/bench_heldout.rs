@@ -73,9 +73,7 @@ pub fn discover_heldout(a: &HeldOutBenchArgs) -> Result<(), LabError> {
                             &Default::default(),
                         )?
                         .0;
-                        let opts = Options {
-                            grade: Some(d.grade.value),
-                        };
+                        let opts = Options::with_grade(Some(d.grade.value));
                         Some(gyro_lab_core::commands::discover::predicts(&run_discover(
                             &d.model_after,
                             &r2,

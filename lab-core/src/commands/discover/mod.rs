@@ -127,7 +127,7 @@ pub fn discover_run(req: Request) -> Result<DiscoverOutcome, LabError> {
     };
     // The model's own effects must be computable on this run.
     computable(&model, &data, &req.source.origin())?;
-    let opts = Options { grade: req.grade };
+    let opts = Options::with_grade(req.grade);
     let d = discover(&model, &data, &opts);
     // The model written, on another run of the same gyro: what it still
     // misses there.
@@ -135,9 +135,7 @@ pub fn discover_run(req: Request) -> Result<DiscoverOutcome, LabError> {
         Some(src) => {
             let (v, _) = read_run(src, req.spec)?;
             computable(&d.model_after, &v, &src.origin())?;
-            let opts_v = Options {
-                grade: Some(d.grade.value),
-            };
+            let opts_v = Options::with_grade(Some(d.grade.value));
             // The model held as written (its terms not refitted): what
             // it predicts of a run it was not fitted on.
             let terms = second_run_terms(&d, &v);

@@ -489,7 +489,8 @@ pub fn discover_library(model: &Model, run: &Run, opts: &Options) -> Discovery {
         None => GradeChoice::inferred(arw_of_floor(floor, window_spacing(&win1))),
     };
     let disagreements = disagreements(&inp.t, &r, allan_before.as_ref(), SMOOTH_S);
-    let (cands, skipped) = candidates(model.gyro, inp);
+    let (mut cands, skipped) = candidates(model.gyro, inp);
+    cands.retain(|e| !opts.excludes(*e));
     // The selection, run again without any named effect or unexplained
     // term the fit does not need once its noise is re-fitted without it
     // (confirm.rs).

@@ -12,6 +12,7 @@
 use super::noise_model::{NoiseModel, Whitener};
 use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
 use super::select::Implausible;
+use super::select::THRESHOLD as NAME_THRESHOLD;
 use crate::model::effects::Effect;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
@@ -36,7 +37,12 @@ pub const MAX_PROPOSED: usize = 2;
 /// as much an imperfect library effect or noise model (a sensor's lag, a
 /// flicker at the floor) as a missing term, and a term would be named
 /// for a few percent of the gap.
-pub const MIN_GAP_OVER_FLOOR: f64 = 1.5;
+pub const MIN_GAP_OVER_FLOOR: f64 = 1.2;
+
+/// Below this many times the noise floor a proposed term must also be
+/// confirmed by the noise fitted again with it in place (the gate that
+/// started a search until issue 39's last session).
+pub const CONFIRM_BELOW: f64 = 1.5;
 
 /// The least share of the gap's excess over the noise floor (in variance)
 /// a proposed term must close.
@@ -134,6 +140,113 @@ fn refit(
     y.iter_mut().zip(&own).for_each(|(a, b)| *a += b);
     let fit = fit_columns(given, d, inp, &rows, Some(i));
     fit_term(t, free, inp, &y, &fit, &|x| rows.dph(x))
+}
+
+/// The term just added (the model's last) with its coefficients fitted
+/// again beside the effects the library named with it, and the library
+/// run once more, where that shrinks the gap. The search fitted them
+/// beside the effects named without it, and those may be the term's
+/// stand-ins that the library drops once it is in (a Shupe bias beside a
+/// temperature's curvature): the coefficient carried would be theirs too.
+fn settle(
+    given: &Model,
+    m2: Model,
+    next: Discovery,
+    run: &Run,
+    opts: &Options,
+    discover_library: Library,
+) -> (Model, Discovery) {
+    let i = m2.terms.len() - 1;
+    let Some(t) = next.model_after.terms.get(i) else {
+        return (m2, next);
+    };
+    let free: Vec<String> = t
+        .params
+        .keys()
+        .filter(|p| is_linear(t, p, &run.inputs))
+        .cloned()
+        .collect();
+    let Some(f) = refit(given, &next, run, i, &free) else {
+        return (m2, next);
+    };
+    if f.term.params == t.params {
+        return (m2, next);
+    }
+    let mut m3 = m2.clone();
+    m3.terms[i] = f.term;
+    let again = discover_library(&m3, run, opts);
+    if again.gap_after_dph < next.gap_after_dph {
+        (m3, again)
+    } else {
+        (m2, next)
+    }
+}
+
+/// The library's names beside the proposed terms, each asked whether it
+/// pays its way with them in place: the library run without it, the
+/// proposed terms refitted in all their parameters beside what is left
+/// (a lag's time constant moves where a scale factor over temperature had
+/// stood in for the difference), and the name dropped where the 1 s
+/// means' sum of squares it saves, in noise variances, is under the
+/// library's own criterion (its threshold and ln n per parameter). The
+/// simplest model the data allow: a term and the name that imitates a
+/// part of it are one effect told twice. Where the library names another
+/// effect in its place, the name stays.
+fn prune(
+    given: &Model,
+    mut m: Model,
+    mut cur: Discovery,
+    run: &Run,
+    opts: &Options,
+    discover_library: Library,
+    users: usize,
+) -> (Model, Discovery, Vec<String>) {
+    let mut pruned = vec![];
+    // The gap's windows (1 s means), which the gaps are the RMS of.
+    let n1 = cur.gap_windows.len() as f64;
+    let mut o = *opts;
+    let named: Vec<(Effect, usize)> = cur
+        .found
+        .iter()
+        .filter(|e| e.effect != Effect::Bias && !given.effects.iter().any(|g| g.effect == e.effect))
+        .map(|e| (e.effect, e.params.len()))
+        .collect();
+    for (e, dof) in named {
+        let o2 = o.excluding(e);
+        let mut d = discover_library(&m, run, &o2);
+        let mut m2 = m.clone();
+        for i in users..m.terms.len() {
+            let Some(t) = d.model_after.terms.get(i) else {
+                continue;
+            };
+            let all: Vec<String> = t.params.keys().cloned().collect();
+            if let Some(f) = refit(given, &d, run, i, &all) {
+                m2.terms[i] = f.term;
+            }
+        }
+        if m2 != m {
+            d = discover_library(&m2, run, &o2);
+        }
+        let floor2 = cur.noise_floor_dph.powi(2).max(1e-300);
+        let saves = n1 * (d.gap_after_dph.powi(2) - cur.gap_after_dph.powi(2)) / floor2;
+        let asks = NAME_THRESHOLD + dof as f64 * n1.ln();
+        // Dropped only where nothing else is named in its place (a name
+        // for a name is no simpler).
+        let fewer = d
+            .found
+            .iter()
+            .all(|x| cur.found.iter().any(|y| y.effect == x.effect));
+        if saves < asks && fewer {
+            pruned.push(format!(
+                "{} (beside the proposed term it saves {:.1} noise variances, under the {:.1} a name of {dof} parameter(s) needs)",
+                e.name(),
+                saves,
+                asks
+            ));
+            (m, cur, o) = (m2, d, o2);
+        }
+    }
+    (m, cur, pruned)
 }
 
 /// The parameters of a term refitted: all of a user's; a proposed term's
@@ -303,14 +416,33 @@ pub fn beyond(
         // predicts nothing. A term found there must pass the same checks:
         // it closes most of what stands above the floor, with the
         // library's effects fitted again beside it.
+        //
+        // Last, where neither gives one, a look under the white noise
+        // alone: a grade's caps are wide (a consumer MEMS gyro's random
+        // walk may be anything), and an event hundreds of deg/h tall that
+        // the fitted noise took as a wander is still the event. Whitened
+        // by white noise any wander gains, so a term found there must also
+        // be confirmed by the noise fitted again with it in place: refitted
+        // on blocks of the record whitened by that noise, it predicts the
+        // others by the space's threshold. On a wander it does not: the
+        // wander is still there for the noise to fit.
+        //
+        // Below CONFIRM_BELOW times the floor every look's term is so
+        // confirmed: there a noise model that missed a wander (a Markov
+        // process of minutes read as flicker) leaves as much above the
+        // floor as a term would, and whitened by it the wander gains.
+        let marginal = cur.gap_after_dph < CONFIRM_BELOW * cur.noise_floor_dph;
         let capped = cur.noise.capped(cur.grade.value.noise_caps());
-        let looks: &[&NoiseModel] = if capped == cur.noise {
-            &[&cur.noise]
-        } else {
-            &[&cur.noise, &capped]
-        };
+        let white = cur.noise.capped((0.0, 0.0, 0.0));
+        let mut looks: Vec<(&NoiseModel, bool)> = vec![(&cur.noise, marginal)];
+        if capped != cur.noise {
+            looks.push((&capped, marginal));
+        }
+        if white != capped && white != cur.noise {
+            looks.push((&white, true));
+        }
         let mut accepted = None;
-        for noise in looks {
+        for (noise, confirm) in looks {
             let rows = Rows::with_noise(&cur, noise);
             let y = rows.dps(&cur.residual_after);
             let fit = fit_columns(given, &cur, inp, &rows, None);
@@ -333,6 +465,7 @@ pub fn beyond(
             let mut m2 = m.clone();
             m2.terms.push(pr.term.clone());
             let next = discover_library(&m2, run, opts);
+            let (m2, next) = settle(given, m2, next, run, opts, discover_library);
             // What stood above the floor, and what of it the term closed:
             // a term that predicts a little of a residual it cannot
             // explain (a slow wander the noise model misread) is not the
@@ -352,6 +485,25 @@ pub fn beyond(
                     100.0 * MIN_CLOSED
                 ));
                 continue;
+            }
+            if confirm {
+                let i = m2.terms.len() - 1;
+                let t = &next.model_after.terms[i];
+                let free: Vec<String> = t
+                    .params
+                    .keys()
+                    .filter(|q| is_linear(t, q, inp))
+                    .cloned()
+                    .collect();
+                let gain = refit(given, &next, run, i, &free)
+                    .map_or(f64::NAN, |f| f.validation.held_out_gain);
+                if gain.is_nan() || gain < p.threshold {
+                    log.note = Some(format!(
+                        "{} ({}) predicted blocks of the record it was not fitted on, but with the noise fitted again beside it, it predicts them by {:.1} noise variances, below the threshold of {:.1}: the noise's wander, not an effect; not added",
+                        pr.label, pr.term.formula, gain, p.threshold
+                    ));
+                    continue;
+                }
             }
             if next.gap_after_dph >= cur.gap_after_dph {
                 log.note = Some(format!(
@@ -373,6 +525,10 @@ pub fn beyond(
         closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
         proposed.push((pr.label.clone(), pr.intervals, pr.validation));
         (m, cur) = (m2, next);
+    }
+    let mut pruned = vec![];
+    if !proposed.is_empty() {
+        (_, cur, pruned) = prune(given, m, cur, run, opts, discover_library, users);
     }
     // Every term's final values, intervals and validation, beside the
     // effects named with it.
@@ -459,6 +615,7 @@ pub fn beyond(
         });
     }
     let mut out = cur;
+    out.dropped.extend(pruned);
     out.terms = found;
     out.proposals = log;
     // The gap before, its residual and where it disagreed: the model

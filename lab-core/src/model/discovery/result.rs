@@ -34,6 +34,29 @@ pub struct Options {
     /// The gyro's grade (`--grade`); judged from the run's white noise
     /// when None.
     pub grade: Option<Grade>,
+    /// Effects the library is not to offer (a bit per `Effect as u32`):
+    /// the discovery's own, when it asks whether a name beside a proposed
+    /// term pays its way (outside.rs).
+    pub exclude: u64,
+}
+
+impl Options {
+    /// The grade given, nothing excluded.
+    pub fn with_grade(grade: Option<Grade>) -> Self {
+        Self { grade, exclude: 0 }
+    }
+
+    pub fn excludes(&self, e: crate::model::effects::Effect) -> bool {
+        self.exclude & (1u64 << e as u32) != 0
+    }
+
+    /// These options with `e` excluded too.
+    pub fn excluding(self, e: crate::model::effects::Effect) -> Self {
+        Self {
+            exclude: self.exclude | (1u64 << e as u32),
+            ..self
+        }
+    }
 }
 
 /// An effect of the library the run cannot show, and why.

@@ -64,6 +64,9 @@ pub struct Prim {
     pub text: String,
     pub kind: PrimKind,
     pub searched: Option<Searched>,
+    /// A candidate by itself only (in no product, no power): a variant of
+    /// another primitive that the products already carry.
+    pub alone: bool,
 }
 
 impl Prim {
@@ -73,6 +76,7 @@ impl Prim {
             text,
             kind: PrimKind::Input,
             searched: None,
+            alone: false,
         }
     }
 
@@ -173,8 +177,31 @@ const PRODUCT_ONSETS: usize = 48;
 const PRODUCT_PERIODS: usize = 40;
 const PRODUCT_DECAYS: usize = 20;
 
+/// Half widths, s, of a temperature's curvature besides the default
+/// (`d2dt2(x)`, eval.rs's 120 s), each a candidate by itself. Where the
+/// temperature turns fast (a chamber's corner through a coil's lag of a
+/// few minutes) the default smooths the curvature the term follows; where
+/// a quantised sensor creeps, a narrow one is all noise. The best width
+/// is the data's (instruments/d2t_bound: within a few percent of what any
+/// linear filter can do). Widths under three rows are left out.
+pub const CURVATURE_HALF_WIDTHS_S: [f64; 4] = [15.0, 30.0, 60.0, 240.0];
+
+/// A pulse's width, its second searched parameter (the refinement moves
+/// its onset with the end held).
+pub const PULSE_WIDTH: &str = "w_s";
+
 /// Widths a pulse is searched over.
 const PULSE_WIDTHS: usize = 10;
+
+/// The median spacing of the rows, s (0 with fewer than two).
+fn median_step(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+    if d.is_empty() {
+        return 0.0;
+    }
+    let k = d.len() / 2;
+    *d.select_nth_unstable_by(k, f64::total_cmp).1
+}
 
 /// `n` values from `a` to `b`, evenly spaced in log.
 fn log_grid(a: f64, b: f64, n: usize) -> Vec<f64> {
@@ -201,6 +228,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
         p.push(Prim::input("|rate|".into(), format!("abs({w})")));
     }
     let span = inp.t.last().copied().unwrap_or(0.0) - inp.t.first().copied().unwrap_or(0.0);
+    let row_s = median_step(&inp.t);
     let mut temps: Vec<(&str, &str, &[f64])> = vec![];
     if let Some(x) = &inp.temp {
         temps.push((Column::Temp.name(), "temperature", x));
@@ -235,6 +263,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                         name: "tau_s",
                         grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
                     }),
+                    alone: false,
                 });
             }
         }
@@ -262,6 +291,18 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
             format!("{name}'s curvature"),
             format!("d2dt2({col})"),
         ));
+        for h in CURVATURE_HALF_WIDTHS_S
+            .into_iter()
+            .filter(|&h| h >= 3.0 * row_s)
+        {
+            p.push(Prim {
+                alone: true,
+                ..Prim::input(
+                    format!("{name}'s curvature over {h:.0} s"),
+                    format!("d2dt2({col}, {h:.0})"),
+                )
+            });
+        }
         if span / 4.0 > 2.0 * LAG_TAU_MIN_S {
             p.push(Prim {
                 label: format!("{name} through a lag"),
@@ -271,6 +312,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                     name: "tau_s",
                     grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
                 }),
+                alone: false,
             });
         }
     }
@@ -286,6 +328,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
             text: format!("{t} / 3600"),
             kind: PrimKind::Hours,
             searched: None,
+            alone: false,
         });
         p.push(Prim {
             label: "a decay".into(),
@@ -295,6 +338,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                 name: "tau_s",
                 grid: log_grid(60.0, span, PRODUCT_DECAYS),
             }),
+            alone: false,
         });
         p.push(Prim {
             label: "a step".into(),
@@ -304,6 +348,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                 name: "t0_s",
                 grid: onsets(t0, span, PRODUCT_ONSETS),
             }),
+            alone: false,
         });
         if span >= 600.0 {
             p.push(Prim {
@@ -314,6 +359,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                     name: "p_s",
                     grid: log_grid(300.0, span / 2.0, PRODUCT_PERIODS),
                 }),
+                alone: false,
             });
         }
     }
@@ -393,13 +439,18 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
     for &i in &inputs {
         c.push(product(&prims, vec![f(i, 1)]));
         // |rate|^2 is rate^2.
-        if prims[i].label != "|rate|" && prims[i].label != "|acceleration|" {
+        if !prims[i].alone && prims[i].label != "|rate|" && prims[i].label != "|acceleration|" {
             c.push(product(&prims, vec![f(i, 2)]));
             c.push(product(&prims, vec![f(i, 3)]));
         }
     }
-    for (a, &i) in inputs.iter().enumerate() {
-        for &j in &inputs[a + 1..] {
+    let composable: Vec<usize> = inputs
+        .iter()
+        .copied()
+        .filter(|&i| !prims[i].alone)
+        .collect();
+    for (a, &i) in composable.iter().enumerate() {
+        for &j in &composable[a + 1..] {
             // One lag per candidate (its time constant is one parameter).
             if prims[i].searched.is_some() && prims[j].searched.is_some() {
                 continue;
@@ -422,7 +473,7 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
     // factor that jumps at a mode hop, a table's periodic error): a
     // temperature is itself slow in time, and its product with a step
     // imitates the events of time alone.
-    for &i in inputs.iter().filter(|&&i| prims[i].searched.is_none()) {
+    for &i in composable.iter().filter(|&&i| prims[i].searched.is_none()) {
         let fast = prims[i].text.contains(Column::RefRate.name())
             || prims[i].text.contains(Column::RefAcc.name());
         for &s in &shapes {
@@ -490,7 +541,7 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
                     grid: on.clone(),
                 },
                 Searched {
-                    name: "w_s",
+                    name: PULSE_WIDTH,
                     grid: log_grid(60.0, span / 2.0, PULSE_WIDTHS),
                 },
             ],

@@ -89,7 +89,7 @@ pub fn names(n: &Node) -> Vec<(String, Range<usize>)> {
             Expr::Num(_) => {}
             Expr::Name(s) => out.push((s.clone(), n.span.clone())),
             Expr::Neg(x) | Expr::Call(_, x) => go(x, out),
-            Expr::Bin(_, l, r) | Expr::Lag(l, r) => {
+            Expr::Bin(_, l, r) | Expr::Lag(l, r) | Expr::Within(_, l, r) => {
                 go(l, out);
                 go(r, out);
             }
@@ -181,6 +181,18 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
                 Val::Row(r) => Val::Row(lag(t, &r, tau)),
             }
         }
+        Expr::Within(f, x, h) => {
+            let half = match eval(h, env, at)? {
+                Val::All(v) if v > 0.0 && v.is_finite() => v,
+                _ => {
+                    return Err(EvalError {
+                        span: h.span.clone(),
+                        msg: format!("{}'s half width is a positive number of seconds", f.name()),
+                    })
+                }
+            };
+            derivative(*f, eval(x, env, at)?, env, half)
+        }
         Expr::Call(f, x) => {
             let a = eval(x, env, at)?;
             match f {
@@ -197,22 +209,22 @@ fn eval(n: &Node, env: &Env, at: &dyn Fn(usize) -> String) -> Result<Val, EvalEr
                 Func::Step => a.map(|v| if v >= 0.0 { 1.0 } else { 0.0 }),
                 // Parsed as Expr::Lag (two arguments); never one.
                 Func::Lag => return Err(err("lag takes two arguments: lag(x, tau)".into())),
-                Func::Ddt | Func::D2dt2 => {
-                    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
-                    let row = match a {
-                        // The derivative of a constant.
-                        Val::All(_) => return Ok(Val::All(0.0)),
-                        Val::Row(r) => r,
-                    };
-                    Val::Row(if *f == Func::Ddt {
-                        centered_slope(t, &row, DDT_HALF_WIDTH_S)
-                    } else {
-                        curvature(t, &row, D2DT2_HALF_WIDTH_S)
-                    })
-                }
+                Func::Ddt => derivative(*f, a, env, DDT_HALF_WIDTH_S),
+                Func::D2dt2 => derivative(*f, a, env, D2DT2_HALF_WIDTH_S),
             }
         }
     })
+}
+
+/// `ddt` or `d2dt2` of `a` with its slopes over `half` s either side.
+fn derivative(f: Func, a: Val, env: &Env, half: f64) -> Val {
+    let t = env.columns.get(Column::Time.name()).copied().unwrap_or(&[]);
+    match a {
+        // The derivative of a constant.
+        Val::All(_) => Val::All(0.0),
+        Val::Row(r) if f == Func::Ddt => Val::Row(centered_slope(t, &r, half)),
+        Val::Row(r) => Val::Row(curvature(t, &r, half)),
+    }
 }
 
 /// `x` through a first-order lag of time constant `tau` s over times
@@ -369,5 +381,42 @@ mod tests {
         );
         let e = run("({t} - 3)^0.5", &[(Column::Time, t)], &[]).unwrap_err();
         assert!(e.msg.contains(&f("not finite (at {t} = 0)")), "{}", e.msg);
+    }
+
+    #[test]
+    fn a_derivative_over_a_half_width_given() {
+        // A curvature that changes: x = t^4 / 12, so x'' = t^2. A least-
+        // squares slope over +-h adds h^2/10 of the third derivative, so
+        // the nested slopes read t^2 + 2 h^2 / 5: the width is honoured.
+        let t: Vec<f64> = (0..3000).map(|k| k as f64 * 0.1).collect();
+        let x: Vec<f64> = t.iter().map(|t| t.powi(4) / 12.0).collect();
+        let cols = [(Column::Time, t.clone()), (Column::Temp, x)];
+        let at = 1500;
+        for h in [5.0, 20.0] {
+            let c = run(&format!("d2dt2({{T}}, {h})"), &cols, &[]).unwrap();
+            let want = t[at] * t[at] + 0.4 * h * h;
+            assert!(
+                (c[at] - want).abs() < 2e-3 * want,
+                "h {h}: {} vs {want}",
+                c[at]
+            );
+        }
+        // The width may be a parameter; the default is D2DT2_HALF_WIDTH_S.
+        let a = run("d2dt2({T}, h_s)", &cols, &[("h_s", D2DT2_HALF_WIDTH_S)]).unwrap();
+        let b = run("d2dt2({T})", &cols, &[]).unwrap();
+        assert_eq!(a, b);
+        let a = run("ddt({T}, 30)", &cols, &[]).unwrap();
+        let b = run("ddt({T})", &cols, &[]).unwrap();
+        assert_eq!(a, b);
+        // It prints as it parses.
+        let n = crate::model::term::parse::parse(&f("k * d2dt2({T}, 60)")).unwrap();
+        assert_eq!(
+            crate::model::term::parse::to_text(&n),
+            f("k * d2dt2({T}, 60)")
+        );
+        // A width that is not a positive number of seconds, at its place.
+        let e = run("d2dt2({T}, 0)", &cols, &[]).unwrap_err();
+        assert!(e.msg.contains("half width"), "{}", e.msg);
+        assert_eq!(e.span, f("d2dt2({T}, ").len()..f("d2dt2({T}, 0").len());
     }
 }

@@ -8,13 +8,16 @@
 //! product = unary (("*" | "/") unary)*
 //! unary   = "-" unary | power
 //! power   = atom ("^" unary)?            (right-associative: 2^3^2 = 2^9)
-//! atom    = number | name | name "(" expr ")" | "lag" "(" expr "," expr ")" | "(" expr ")"
+//! atom    = number | name | name "(" expr ")" | "lag" "(" expr "," expr ")"
+//!         | ("ddt" | "d2dt2") "(" expr ("," expr)? ")" | "(" expr ")"
 //! ```
 //!
 //! `-x^2` is `-(x^2)`, as in mathematics; a name followed by `(` is a
 //! function (`abs sin cos exp step ddt d2dt2`, and `lag(x, tau)`: `x`
 //! through a first-order lag of time constant `tau` s), any other name a
-//! column of the run, a parameter, or `pi`.
+//! column of the run, a parameter, or `pi`. `ddt(x, h)` and `d2dt2(x, h)`
+//! take their slopes over `h` s either side instead of the tool's default
+//! (eval.rs).
 
 use std::ops::Range;
 
@@ -108,6 +111,9 @@ pub enum Expr {
     Call(Func, Box<Node>),
     /// `lag(x, tau)`.
     Lag(Box<Node>, Box<Node>),
+    /// `ddt(x, h)` or `d2dt2(x, h)`: the derivative with its slopes over
+    /// `h` s either side.
+    Within(Func, Box<Node>, Box<Node>),
 }
 
 /// A node and the byte span of its text in the formula.
@@ -331,6 +337,9 @@ impl Parser<'_> {
                     }
                     self.at += 1;
                     Some(self.sum()?)
+                } else if matches!(f, Func::Ddt | Func::D2dt2) && self.is_sym(',') {
+                    self.at += 1;
+                    Some(self.sum()?)
                 } else {
                     None
                 };
@@ -341,7 +350,8 @@ impl Parser<'_> {
                 self.at += 1;
                 Ok(Node {
                     expr: match second {
-                        Some(tau) => Expr::Lag(Box::new(arg), Box::new(tau)),
+                        Some(tau) if f == Func::Lag => Expr::Lag(Box::new(arg), Box::new(tau)),
+                        Some(h) => Expr::Within(f, Box::new(arg), Box::new(h)),
                         None => Expr::Call(f, Box::new(arg)),
                     },
                     span: span.start..end,
@@ -427,6 +437,14 @@ pub fn to_text(n: &Node) -> String {
                 go(x, out, 0, None);
                 out.push_str(", ");
                 go(tau, out, 0, None);
+                out.push(')');
+            }
+            Expr::Within(f, x, h) => {
+                out.push_str(f.name());
+                out.push('(');
+                go(x, out, 0, None);
+                out.push_str(", ");
+                go(h, out, 0, None);
                 out.push(')');
             }
             Expr::Bin(op, l, r) => {
