@@ -9,6 +9,7 @@
 //! A proposal is kept only where the gap after shrinks with it; the gap
 //! before stays the model given's.
 
+use super::likelihood::{self, Problem};
 use super::noise_model::{NoiseModel, Whitener};
 use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
 use super::select::Implausible;
@@ -180,6 +181,22 @@ fn settle(
     } else {
         (m2, next)
     }
+}
+
+/// Twice the log-likelihood ratio of `t` on what `d`'s model leaves: its
+/// shape as proposed, its size and a constant free, against the constant
+/// alone, each side with the noise's random walk, flicker and Markov
+/// levels at their maximum (plain) likelihood (likelihood.rs `profile`).
+fn likelihood_gain(d: &Discovery, t: &Term, inp: &Inputs) -> Option<f64> {
+    let y = d.windows.mean(&d.residual_after);
+    let g: Vec<f64> = t.evaluate(inp).ok()?.iter().map(|v| v / 3600.0).collect();
+    let ones = vec![1.0; y.len()];
+    let without = Problem::new(&d.windows, &d.keep, &y, std::slice::from_ref(&ones));
+    let with = Problem::new(&d.windows, &d.keep, &y, &[ones, d.windows.mean(&g)]);
+    let (_, l0) = likelihood::profile(&d.noise, &without, false);
+    let (_, l1) = likelihood::profile(&d.noise, &with, false);
+    let v = 2.0 * (l1 - l0);
+    v.is_finite().then_some(v)
 }
 
 /// The library's names beside the proposed terms, each asked whether it
@@ -497,6 +514,18 @@ pub fn beyond(
                     .collect();
                 let gain = refit(given, &next, run, i, &free)
                     .map_or(f64::NAN, |f| f.validation.held_out_gain);
+                // ... and the likelihood must prefer it with the noise's
+                // slow levels free on both sides: a smooth term that takes
+                // a wander a random walk explains as well is confirmed by
+                // the noise refitted without the walk, but not here.
+                let lr = likelihood_gain(&cur, &pr.term, inp).unwrap_or(f64::NAN);
+                if lr.is_nan() || lr < p.threshold {
+                    log.note = Some(format!(
+                        "{} ({}) predicted blocks of the record it was not fitted on, but with the noise's slow levels at their most likely beside it and without it, it raises twice the log-likelihood by {:.1}, below the threshold of {:.1}: a wander the noise explains as well; not added",
+                        pr.label, pr.term.formula, lr, p.threshold
+                    ));
+                    continue;
+                }
                 if gain.is_nan() || gain < p.threshold {
                     log.note = Some(format!(
                         "{} ({}) predicted blocks of the record it was not fitted on, but with the noise fitted again beside it, it predicts them by {:.1} noise variances, below the threshold of {:.1}: the noise's wander, not an effect; not added",
