@@ -70,19 +70,17 @@ pub fn test(gyro_lab: &std::path::Path) -> Result<()> {
         .current_dir(root()))
 }
 
-/// gyrolab.allan against allantools' oadev on 2e6 samples: the JSON of
-/// the benchmark's last line.
-pub fn bench_allan() -> Result<serde_json::Value> {
+/// A Python script of the repository run in the package's venv with
+/// `args`: its output printed, and the JSON of its last line.
+fn json_of_script(script: &str, args: &[&std::ffi::OsStr]) -> Result<serde_json::Value> {
     install()?;
     let out = Command::new(python())
-        .arg(root().join("python/benchmarks/allan_speed.py"))
+        .arg(root().join(script))
+        .args(args)
         .current_dir(root())
         .output()?;
     if !out.status.success() {
-        bail!(
-            "python/benchmarks/allan_speed.py failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        bail!("{script} failed: {}", String::from_utf8_lossy(&out.stderr));
     }
     let text = String::from_utf8_lossy(&out.stdout);
     for l in text.lines() {
@@ -91,28 +89,26 @@ pub fn bench_allan() -> Result<serde_json::Value> {
     Ok(serde_json::from_str(text.lines().last().unwrap_or("{}"))?)
 }
 
+/// gyrolab.allan against allantools' oadev on 2e6 samples: the JSON of
+/// the benchmark's last line.
+pub fn bench_allan() -> Result<serde_json::Value> {
+    json_of_script("python/benchmarks/allan_speed.py", &[])
+}
+
 /// The curvature bound (instruments/d2t_bound/bound.py) beside what
 /// `discover` reaches on the same chamber runs: one key per case.
 pub fn bench_d2t(lab: &std::path::Path) -> Result<serde_json::Value> {
-    install()?;
     let work = root().join("runs/d2t");
-    let out = Command::new(python())
-        .arg(root().join("instruments/d2t_bound/bound.py"))
-        .arg("--lab")
-        .arg(lab)
-        .arg("--work")
-        .arg(&work)
-        .arg("--json")
-        .current_dir(root())
-        .output()?;
-    if !out.status.success() {
-        bail!(
-            "instruments/d2t_bound/bound.py failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    let text = String::from_utf8_lossy(&out.stdout);
-    let mut v: serde_json::Value = serde_json::from_str(text.lines().last().unwrap_or("{}"))?;
+    let mut v = json_of_script(
+        "instruments/d2t_bound/bound.py",
+        &[
+            "--lab".as_ref(),
+            lab.as_os_str(),
+            "--work".as_ref(),
+            work.as_os_str(),
+            "--json".as_ref(),
+        ],
+    )?;
     if let Some(o) = v.as_object_mut() {
         o.remove("d2t_rows");
     }

@@ -116,6 +116,16 @@ impl Candidate {
         p.join(" + ")
     }
 
+    /// The searched parameters by name at a point of the search (a value
+    /// per searched parameter, in their order).
+    pub fn params_at(&self, point: &[f64]) -> std::collections::BTreeMap<String, f64> {
+        self.searched
+            .iter()
+            .zip(point)
+            .map(|(s, &v)| (s.name.to_string(), v))
+            .collect()
+    }
+
     /// Linear coefficients plus the searched parameters: what the term can
     /// bend (the simplest explanation has the fewest).
     pub fn freedom(&self) -> usize {

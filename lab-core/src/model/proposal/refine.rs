@@ -29,12 +29,7 @@ fn columns(
     to_rows: ToRows,
     q: &[Vec<f64>],
 ) -> Option<Vec<Vec<f64>>> {
-    let params: BTreeMap<String, f64> = c
-        .searched
-        .iter()
-        .zip(point)
-        .map(|(s, &v)| (s.name.to_string(), v))
-        .collect();
+    let params = c.params_at(point);
     c.parts
         .iter()
         .map(|p| {

@@ -73,12 +73,7 @@ impl<'a> Screen<'a> {
     /// A candidate's columns (window level, one per part) at a point of
     /// its search; None where a factor cannot be evaluated.
     pub fn columns(&self, prims: &[Prim], c: &Candidate, point: &[f64]) -> Option<Vec<Vec<f64>>> {
-        let params: BTreeMap<String, f64> = c
-            .searched
-            .iter()
-            .zip(point)
-            .map(|(s, &v)| (s.name.to_string(), v))
-            .collect();
+        let params = c.params_at(point);
         if c.recipe.is_empty() {
             // An event searched in two parameters: a shape of time.
             return c
