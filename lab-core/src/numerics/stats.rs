@@ -197,6 +197,15 @@ pub fn median(v: &[f64]) -> f64 {
     median_mut(&mut v.to_vec())
 }
 
+/// The median interval of `t`, s (1 where it has fewer than two rows).
+pub fn median_interval(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return 1.0;
+    }
+    median_mut(&mut d)
+}
+
 /// [`median`] of values the caller owns and no longer needs in order:
 /// reordered in place, no copy.
 pub fn median_mut(v: &mut [f64]) -> f64 {

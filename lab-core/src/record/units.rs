@@ -357,14 +357,7 @@ pub fn check(c: &RateColumn) -> Result<UnitCheck, Refusal> {
     Ok(out)
 }
 
-/// The median interval of `t`, s (1 where it has fewer than two rows).
-pub fn median_interval(t: &[f64]) -> f64 {
-    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    if d.is_empty() {
-        return 1.0;
-    }
-    crate::numerics::stats::median_mut(&mut d)
-}
+pub use crate::numerics::stats::median_interval;
 
 #[cfg(test)]
 mod tests {

@@ -161,12 +161,7 @@ fn settle(
     let Some(t) = next.model_after.terms.get(i) else {
         return (m2, next);
     };
-    let free: Vec<String> = t
-        .params
-        .keys()
-        .filter(|p| is_linear(t, p, &run.inputs))
-        .cloned()
-        .collect();
+    let free = free_params(t, true, &run.inputs);
     let Some(f) = refit(given, &next, run, i, &free) else {
         return (m2, next);
     };
@@ -217,7 +212,7 @@ fn prune(
     opts: &Options,
     discover_library: Library,
     users: usize,
-) -> (Model, Discovery, Vec<String>) {
+) -> (Discovery, Vec<String>) {
     let mut pruned = vec![];
     // The gap's windows (1 s means), which the gaps are the RMS of.
     let n1 = cur.gap_windows.len() as f64;
@@ -236,8 +231,7 @@ fn prune(
             let Some(t) = d.model_after.terms.get(i) else {
                 continue;
             };
-            let all: Vec<String> = t.params.keys().cloned().collect();
-            if let Some(f) = refit(given, &d, run, i, &all) {
+            if let Some(f) = refit(given, &d, run, i, &free_params(t, false, &run.inputs)) {
                 m2.terms[i] = f.term;
             }
         }
@@ -263,7 +257,7 @@ fn prune(
             (m, cur, o) = (m2, d, o2);
         }
     }
-    (m, cur, pruned)
+    (cur, pruned)
 }
 
 /// The parameters of a term refitted: all of a user's; a proposed term's
@@ -504,17 +498,7 @@ pub fn beyond(
                 continue;
             }
             if confirm {
-                let i = m2.terms.len() - 1;
-                let t = &next.model_after.terms[i];
-                let free: Vec<String> = t
-                    .params
-                    .keys()
-                    .filter(|q| is_linear(t, q, inp))
-                    .cloned()
-                    .collect();
-                let gain = refit(given, &next, run, i, &free)
-                    .map_or(f64::NAN, |f| f.validation.held_out_gain);
-                // ... and the likelihood must prefer it with the noise's
+                // The likelihood must prefer it with the noise's
                 // slow levels free on both sides: a smooth term that takes
                 // a wander a random walk explains as well is confirmed by
                 // the noise refitted without the walk, but not here.
@@ -526,6 +510,12 @@ pub fn beyond(
                     ));
                     continue;
                 }
+                // ... and, refitted on blocks whitened by the noise fitted
+                // again with it in place, it must predict the others.
+                let i = m2.terms.len() - 1;
+                let t = &next.model_after.terms[i];
+                let gain = refit(given, &next, run, i, &free_params(t, true, inp))
+                    .map_or(f64::NAN, |f| f.validation.held_out_gain);
                 if gain.is_nan() || gain < p.threshold {
                     log.note = Some(format!(
                         "{} ({}) predicted blocks of the record it was not fitted on, but with the noise fitted again beside it, it predicts them by {:.1} noise variances, below the threshold of {:.1}: the noise's wander, not an effect; not added",
@@ -557,7 +547,7 @@ pub fn beyond(
     }
     let mut pruned = vec![];
     if !proposed.is_empty() {
-        (_, cur, pruned) = prune(given, m, cur, run, opts, discover_library, users);
+        (cur, pruned) = prune(given, m, cur, run, opts, discover_library, users);
     }
     // Every term's final values, intervals and validation, beside the
     // effects named with it.

@@ -203,16 +203,6 @@ pub const PULSE_WIDTH: &str = "w_s";
 /// Widths a pulse is searched over.
 const PULSE_WIDTHS: usize = 10;
 
-/// The median spacing of the rows, s (0 with fewer than two).
-fn median_step(t: &[f64]) -> f64 {
-    let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
-    if d.is_empty() {
-        return 0.0;
-    }
-    let k = d.len() / 2;
-    *d.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
 /// `n` values from `a` to `b`, evenly spaced in log.
 fn log_grid(a: f64, b: f64, n: usize) -> Vec<f64> {
     (0..n)
@@ -238,7 +228,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
         p.push(Prim::input("|rate|".into(), format!("abs({w})")));
     }
     let span = inp.t.last().copied().unwrap_or(0.0) - inp.t.first().copied().unwrap_or(0.0);
-    let row_s = median_step(&inp.t);
+    let row_s = crate::numerics::stats::median_interval(&inp.t);
     let mut temps: Vec<(&str, &str, &[f64])> = vec![];
     if let Some(x) = &inp.temp {
         temps.push((Column::Temp.name(), "temperature", x));
