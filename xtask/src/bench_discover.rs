@@ -3,6 +3,9 @@
 //! model) of 1 h at 10 Hz, 6 h, 24 h and 72 h at 1 Hz and 24 h at 10 Hz,
 //! each timed wall-clock and its peak memory read from the kernel's
 //! accounting of that one child (wait4), each checked to find the three.
+//! The same at 6, 24 and 72 h with a fourth effect outside the library (a
+//! bias following the coil's temperature through a 30 min lag): the
+//! search over the grammar's candidates runs, and the keys end `_term`.
 
 use anyhow::{bail, Context, Result};
 use std::path::Path;
@@ -40,21 +43,28 @@ fn rounded(v: f64, digits: i32) -> f64 {
 /// The costs as JSON keys.
 pub fn costs(lab: &Path, dir: &Path) -> Result<serde_json::Value> {
     std::fs::create_dir_all(dir)?;
-    let truth = dir.join("bench-truth.toml");
-    std::fs::write(
-        &truth,
-        "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n\
+    let library = "kind = \"gyro_model\"\nversion = 1\ngyro = \"fog\"\n\
          [[effect]]\nname = \"scale_factor_temperature\"\nppm_per_c = 1.5\n\
          [[effect]]\nname = \"scale_factor_knee\"\nknee_c = 30.0\nslope_change_ppm_per_c = 4.0\n\
-         [[effect]]\nname = \"bias\"\nbias_dph = 0.2\n",
-    )?;
+         [[effect]]\nname = \"bias\"\nbias_dph = 0.2\n";
+    let outside = format!(
+        "{library}[[effect]]\nname = \"term\"\n\
+         formula = \"k_dph * (lag(temp_c, tau_s) - 20)\"\nk_dph = 0.02\ntau_s = 1800\n"
+    );
+    let truth = dir.join("bench-truth.toml");
+    let truth_term = dir.join("bench-truth-term.toml");
+    std::fs::write(&truth, library)?;
+    std::fs::write(&truth_term, outside)?;
     let mut j = serde_json::Map::new();
-    for (key, dt, hours) in [
-        ("discover_1h_10hz", "0.1", 1),
-        ("discover_6h_1hz", "1", 6),
-        ("discover_24h_1hz", "1", 24),
-        ("discover_24h_10hz", "0.1", 24),
-        ("discover_72h_1hz", "1", 72),
+    for (key, dt, hours, with_term) in [
+        ("discover_1h_10hz", "0.1", 1, false),
+        ("discover_6h_1hz", "1", 6, false),
+        ("discover_24h_1hz", "1", 24, false),
+        ("discover_24h_10hz", "0.1", 24, false),
+        ("discover_72h_1hz", "1", 72, false),
+        ("discover_6h_1hz_term", "1", 6, true),
+        ("discover_24h_1hz_term", "1", 24, true),
+        ("discover_72h_1hz_term", "1", 72, true),
     ] {
         let run_file = dir.join(format!("{key}.csv"));
         let st = Command::new(lab)
@@ -68,7 +78,7 @@ pub fn costs(lab: &Path, dir: &Path) -> Result<serde_json::Value> {
                 dt,
             ])
             .args(["--duration-s", &(hours * 3600).to_string(), "--model"])
-            .arg(&truth)
+            .arg(if with_term { &truth_term } else { &truth })
             .arg("--out")
             .arg(&run_file)
             .stdout(Stdio::null())
@@ -86,8 +96,9 @@ pub fn costs(lab: &Path, dir: &Path) -> Result<serde_json::Value> {
         )?;
         let v: serde_json::Value =
             serde_json::from_str(text.lines().last().unwrap_or("{}")).context("discover's JSON")?;
-        if v["found"].as_array().map_or(0, |f| f.len()) != 3 {
-            bail!("discover on {key} did not find the three hidden effects: {v}");
+        let want = 3 + usize::from(with_term);
+        if v["found"].as_array().map_or(0, |f| f.len()) != want {
+            bail!("discover on {key} did not find the {want} hidden effects: {v}");
         }
         j.insert(format!("{key}_s"), rounded(wall, 3).into());
         j.insert(format!("{key}_peak_mb"), rounded(mb, 1).into());

@@ -17,8 +17,9 @@ use super::select::THRESHOLD as NAME_THRESHOLD;
 use crate::model::effects::Effect;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
+use crate::model::proposal::orthogonal::{basis, dot, orthogonal};
 use crate::model::proposal::refit::{fit_term, is_linear};
-use crate::model::proposal::{propose, Validation};
+use crate::model::proposal::{propose, Validation, Variant};
 use crate::model::term::Term;
 use std::collections::BTreeMap;
 
@@ -94,8 +95,23 @@ fn fit_columns(
     rows: &Rows,
     skip: Option<usize>,
 ) -> Vec<Vec<f64>> {
-    let mut cols = vec![rows.dps(&vec![1.0; inp.len()])];
+    columns_of(given, d, inp, (skip, None), &|x| rows.dps(x))
+}
+
+/// The columns of `d`'s fit (as [`fit_columns`], but term `skip.0` and
+/// effect `skip.1`), per row in deg/s, each mapped by `map`.
+fn columns_of(
+    given: &Model,
+    d: &Discovery,
+    inp: &Inputs,
+    skip: (Option<usize>, Option<Effect>),
+    map: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let mut cols = vec![map(&vec![1.0; inp.len()])];
     for e in d.model_after.effects.iter().skip(given.effects.len()) {
+        if Some(e.effect) == skip.1 {
+            continue;
+        }
         let c0 = e.effect.contribution(inp, &e.params);
         for (p, &v) in &e.params {
             let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
@@ -103,26 +119,75 @@ fn fit_columns(
             q.insert(p.clone(), v + h);
             let c1 = e.effect.contribution(inp, &q);
             let col: Vec<f64> = c1.iter().zip(&c0).map(|(a, b)| (a - b) / h).collect();
-            cols.push(rows.dps(&col));
+            cols.push(map(&col));
         }
     }
     for (i, t) in d.model_after.terms.iter().enumerate() {
-        if Some(i) == skip {
-            continue;
-        }
-        let Ok(g0) = t.evaluate(inp) else { continue };
-        for (p, &v) in &t.params {
-            let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
-            let mut u = t.clone();
-            u.params.insert(p.clone(), v + h);
-            if let Ok(g1) = u.evaluate(inp) {
-                let col: Vec<f64> = g1.iter().zip(&g0).map(|(a, b)| (a - b) / h).collect();
-                cols.push(rows.dph(&col));
-            }
+        if Some(i) != skip.0 {
+            cols.extend(term_columns(t, inp, map));
         }
     }
     cols
 }
+
+/// A term's columns: its derivative in each parameter, per row in deg/s,
+/// each mapped by `map`.
+fn term_columns(t: &Term, inp: &Inputs, map: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec<Vec<f64>> {
+    let Ok(g0) = t.evaluate(inp) else {
+        return vec![];
+    };
+    let mut cols = vec![];
+    for (p, &v) in &t.params {
+        let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
+        let mut u = t.clone();
+        u.params.insert(p.clone(), v + h);
+        if let Ok(g1) = u.evaluate(inp) {
+            let col: Vec<f64> = g1
+                .iter()
+                .zip(&g0)
+                .map(|(a, b)| (a - b) / h / 3600.0)
+                .collect();
+            cols.push(map(&col));
+        }
+    }
+    cols
+}
+
+/// At least what library name `e` saves beside the rest of `cur`'s fit
+/// (and `extra`'s parameters), in the noise variances `prune` counts:
+/// the gap's 1 s means with `e` taken out and every other column refitted
+/// by least squares, less the gap now. No refit of them, linear in their
+/// parameters (a shape's parameters to first order), can leave less, so
+/// a name that saves several times its criterion by this bound is kept
+/// without running the library again.
+fn saves_at_least(
+    given: &Model,
+    cur: &Discovery,
+    e: Effect,
+    extra: Option<&Term>,
+    inp: &Inputs,
+) -> f64 {
+    let gw = &cur.gap_windows;
+    let map = |x: &[f64]| gw.mean(x);
+    let Some(fx) = cur.model_after.effects.iter().find(|x| x.effect == e) else {
+        return 0.0;
+    };
+    let mut cols = columns_of(given, cur, inp, (None, Some(e)), &map);
+    if let Some(t) = extra {
+        cols.extend(term_columns(t, inp, &map));
+    }
+    let q = basis(&cols);
+    let r = gw.mean(&cur.residual_after);
+    let c = gw.mean(&fx.effect.contribution(inp, &fx.params));
+    let without = orthogonal(r.iter().zip(&c).map(|(a, b)| a + b).collect(), &q);
+    let floor = cur.noise_floor_dph / 3600.0;
+    (dot(&without, &without) - dot(&r, &r)) / (floor * floor).max(1e-300)
+}
+
+/// How many times its criterion [`saves_at_least`] must show a name to
+/// save before `prune` keeps it unasked (the library run again may also
+/// move a shape's parameters beyond first order).
+const SURELY: f64 = 3.0;
 
 /// Term `i` of `d`'s model fitted on `d`'s residual (its other terms and
 /// effects carried), `free` its parameters let move.
@@ -194,6 +259,36 @@ fn likelihood_gain(d: &Discovery, t: &Term, inp: &Inputs) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
+/// `m` with term `swap.0` replaced by `swap.1` (if any), the library run
+/// on it with `o`, the proposed terms (from `users` on) refitted in all
+/// their parameters beside what it names, and the library run again.
+fn refitted_without(
+    given: &Model,
+    m: &Model,
+    swap: Option<(usize, &Term)>,
+    (run, o, discover_library): (&Run, &Options, Library),
+    users: usize,
+) -> (Model, Discovery) {
+    let mut m1 = m.clone();
+    if let Some((i, t)) = swap {
+        m1.terms[i] = t.clone();
+    }
+    let mut d = discover_library(&m1, run, o);
+    let mut m2 = m1.clone();
+    for i in users..m1.terms.len() {
+        let Some(t) = d.model_after.terms.get(i) else {
+            continue;
+        };
+        if let Some(f) = refit(given, &d, run, i, &free_params(t, false, &run.inputs)) {
+            m2.terms[i] = f.term;
+        }
+    }
+    if m2 != m1 {
+        d = discover_library(&m2, run, o);
+    }
+    (m2, d)
+}
+
 /// The library's names beside the proposed terms, each asked whether it
 /// pays its way with them in place: the library run without it, the
 /// proposed terms refitted in all their parameters beside what is left
@@ -204,14 +299,19 @@ fn likelihood_gain(d: &Discovery, t: &Term, inp: &Inputs) -> Option<f64> {
 /// simplest model the data allow: a term and the name that imitates a
 /// part of it are one effect told twice. Where the library names another
 /// effect in its place, the name stays.
+///
+/// Where the term alone cannot take the name's place, its variants with
+/// a second part are asked (the term led, or its lagged input part
+/// direct: a sensor that lags the physics makes a lagged effect look
+/// like a lag plus an unlagged scale factor); one that lets the name go
+/// replaces the term and its label (`meta`).
 fn prune(
     given: &Model,
     mut m: Model,
     mut cur: Discovery,
-    run: &Run,
-    opts: &Options,
-    discover_library: Library,
+    (run, opts, discover_library): (&Run, &Options, Library),
     users: usize,
+    (meta, variants): (&mut [ProposedMeta], &[Vec<Variant>]),
 ) -> (Discovery, Vec<String>) {
     let mut pruned = vec![];
     // The gap's windows (1 s means), which the gaps are the RMS of.
@@ -225,35 +325,63 @@ fn prune(
         .collect();
     for (e, dof) in named {
         let o2 = o.excluding(e);
-        let mut d = discover_library(&m, run, &o2);
-        let mut m2 = m.clone();
-        for i in users..m.terms.len() {
-            let Some(t) = d.model_after.terms.get(i) else {
-                continue;
-            };
-            if let Some(f) = refit(given, &d, run, i, &free_params(t, false, &run.inputs)) {
-                m2.terms[i] = f.term;
+        let asks = NAME_THRESHOLD + dof as f64 * n1.ln();
+        let floor2 = cur.noise_floor_dph.powi(2).max(1e-300);
+        // What the name saves, and whether nothing else is named in its
+        // place (a name for a name is no simpler).
+        let judge = |d: &Discovery| {
+            let saves = n1 * (d.gap_after_dph.powi(2) - cur.gap_after_dph.powi(2)) / floor2;
+            let fewer = d
+                .found
+                .iter()
+                .all(|x| cur.found.iter().any(|y| y.effect == x.effect));
+            (saves, saves < asks && fewer)
+        };
+        let ctx = (run, &o2, discover_library);
+        let surely = |extra: Option<&Term>| {
+            saves_at_least(given, &cur, e, extra, &run.inputs) > SURELY * asks
+        };
+        let (mut saves, mut drop, mut chosen) = (f64::NAN, false, None);
+        if !surely(None) {
+            let (m2, d) = refitted_without(given, &m, None, ctx, users);
+            (saves, drop) = judge(&d);
+            chosen = Some((m2, d, None));
+        }
+        if !drop {
+            'variants: for (k, vs) in variants.iter().enumerate() {
+                for (label, v, second) in vs {
+                    // At the term's present values, its new part at zero.
+                    let mut v = v.clone();
+                    for (p, x) in &m.terms[users + k].params {
+                        v.params.insert(p.clone(), *x);
+                    }
+                    if surely(Some(&v)) {
+                        continue;
+                    }
+                    let (m3, d3) = refitted_without(given, &m, Some((users + k, &v)), ctx, users);
+                    let (s3, ok) = judge(&d3);
+                    if ok && second.plausible(&m3.terms[users + k].params) {
+                        (saves, drop) = (s3, true);
+                        chosen = Some((m3, d3, Some((k, label.clone()))));
+                        break 'variants;
+                    }
+                }
             }
         }
-        if m2 != m {
-            d = discover_library(&m2, run, &o2);
-        }
-        let floor2 = cur.noise_floor_dph.powi(2).max(1e-300);
-        let saves = n1 * (d.gap_after_dph.powi(2) - cur.gap_after_dph.powi(2)) / floor2;
-        let asks = NAME_THRESHOLD + dof as f64 * n1.ln();
-        // Dropped only where nothing else is named in its place (a name
-        // for a name is no simpler).
-        let fewer = d
-            .found
-            .iter()
-            .all(|x| cur.found.iter().any(|y| y.effect == x.effect));
-        if saves < asks && fewer {
+        if let (true, Some((m2, d, relabel))) = (drop, chosen) {
+            let by = match &relabel {
+                Some((_, l)) => format!("the proposed term as {l}"),
+                None => "the proposed term".into(),
+            };
             pruned.push(format!(
-                "{} (beside the proposed term it saves {:.1} noise variances, under the {:.1} a name of {dof} parameter(s) needs)",
+                "{} (beside {by} it saves {:.1} noise variances, under the {:.1} a name of {dof} parameter(s) needs)",
                 e.name(),
                 saves,
                 asks
             ));
+            if let Some((k, l)) = relabel {
+                meta[k].0 = l;
+            }
             (m, cur, o) = (m2, d, o2);
         }
     }
@@ -406,6 +534,7 @@ pub fn beyond(
     };
     // Proposals: what they were, with their validation.
     let mut proposed: Vec<ProposedMeta> = vec![];
+    let mut variants: Vec<Vec<Variant>> = vec![];
     let mut log = Proposals::default();
     // Per proposed term: the gap after without and with it, and the share
     // of the excess above the floor it closed.
@@ -543,11 +672,19 @@ pub fn beyond(
         };
         closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
         proposed.push((pr.label.clone(), pr.intervals, pr.validation));
+        variants.push(pr.variants);
         (m, cur) = (m2, next);
     }
     let mut pruned = vec![];
     if !proposed.is_empty() {
-        (cur, pruned) = prune(given, m, cur, run, opts, discover_library, users);
+        (cur, pruned) = prune(
+            given,
+            m,
+            cur,
+            (run, opts, discover_library),
+            users,
+            (&mut proposed, &variants),
+        );
     }
     // Every term's final values, intervals and validation, beside the
     // effects named with it.

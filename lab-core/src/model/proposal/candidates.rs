@@ -67,6 +67,14 @@ pub struct Prim {
     /// A candidate by itself only (in no product, no power): a variant of
     /// another primitive that the products already carry.
     pub alone: bool,
+    /// The formula of the primitive that, beside this one with a
+    /// coefficient of its own, leads it: its derivative (x + tau x' is x
+    /// led by tau), or for a lag the input itself. A sensor that lags the
+    /// physics by tau_s sees (1 + s tau_s) x of it, and a lag seen through
+    /// it is (1 + s tau_s) / (1 + s tau) = tau_s / tau + (1 - tau_s / tau)
+    /// / (1 + s tau): part direct, the rest lagged. Both are linear in
+    /// their coefficients, so a lead costs a coefficient, not a search.
+    pub lead: Option<String>,
 }
 
 impl Prim {
@@ -77,6 +85,14 @@ impl Prim {
             kind: PrimKind::Input,
             searched: None,
             alone: false,
+            lead: None,
+        }
+    }
+
+    fn led_by(self, lead: String) -> Self {
+        Self {
+            lead: Some(lead),
+            ..self
         }
     }
 
@@ -92,6 +108,51 @@ pub struct Factor {
     pub power: i32,
 }
 
+/// What a candidate's second part is to its first (candidates of two
+/// recipes, [`paired`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Second {
+    /// The first's derivative: k (x + tau x'), the physics ahead of the
+    /// sensor by tau = k2 / k.
+    Lead,
+    /// A lag's input itself: k2 / (k + k2) of the effect direct, the rest
+    /// through the lag (a lag tau seen through a sensor's own lag tau_s
+    /// has tau_s / tau of it direct).
+    Direct,
+    /// The first's square: a quadratic.
+    Square,
+}
+
+/// The longest lead of the physics over its sensor, s: a sensor on the
+/// case or the mount, minutes from the element it stands for (a longer
+/// one is a lag of the physics itself, which the lag primitive carries).
+pub const MAX_LEAD_S: f64 = 900.0;
+
+impl Second {
+    /// Whether the two coefficients (the first part's `k_dph`, the
+    /// second's `k2_dph`) describe what the pairing stands for: a sensor
+    /// behind the physics, not ahead of it (a lead of zero to
+    /// [`MAX_LEAD_S`]), or a share of the effect direct between none and
+    /// all whose sensor lag (tau times the share) is no longer than a lead.
+    /// Outside that the pair is two shapes fitted against each other (a
+    /// difference of sensors standing in for another), not a lead.
+    pub fn plausible(self, params: &std::collections::BTreeMap<String, f64>) -> bool {
+        let (Some(&k), Some(&k2)) = (params.get("k_dph"), params.get("k2_dph")) else {
+            return false;
+        };
+        match self {
+            Second::Lead => k != 0.0 && (0.0..=MAX_LEAD_S).contains(&(k2 / k)),
+            // The share direct is tau_s / tau: the sensor's own lag
+            // tau_s = tau k2 / (k + k2), no longer than a lead.
+            Second::Direct => {
+                let tau = params.get("tau_s").copied().unwrap_or(f64::NAN);
+                k * k2 >= 0.0 && k + k2 != 0.0 && tau * k2 / (k + k2) <= MAX_LEAD_S
+            }
+            Second::Square => true,
+        }
+    }
+}
+
 /// A candidate term: its parts (summed), the parameters searched (none,
 /// one, or two, searched on every pair of their grids), and, for the
 /// screening, the primitives it is the product of (empty for the events
@@ -103,6 +164,10 @@ pub struct Candidate {
     pub parts: Vec<Part>,
     pub searched: Vec<Searched>,
     pub recipe: Vec<Factor>,
+    /// The recipes of further linear parts, screened as the first is (a
+    /// primitive's lead or square beside it), and what the second is.
+    pub also: Vec<Vec<Factor>>,
+    pub second: Option<Second>,
 }
 
 impl Candidate {
@@ -135,7 +200,12 @@ impl Candidate {
     /// How composed it is: its factors' powers summed (a primitive 1, a
     /// square or a product 2), the simpler preferred among equals.
     pub fn order(&self) -> i32 {
-        self.recipe.iter().map(|f| f.power).sum::<i32>().max(1)
+        std::iter::once(&self.recipe)
+            .chain(&self.also)
+            .map(|r| r.iter().map(|f| f.power).sum::<i32>())
+            .max()
+            .unwrap_or(0)
+            .max(1)
     }
 
     /// Every point of the search: one value per searched parameter, in
@@ -256,14 +326,15 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
             ));
             if span / 4.0 > 2.0 * LAG_TAU_MIN_S {
                 p.push(Prim {
-                    label: format!("{na} less {nb} through a lag"),
-                    text: format!("lag({a} - {b}, tau_s)"),
-                    kind: PrimKind::Input,
                     searched: Some(Searched {
                         name: "tau_s",
                         grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
                     }),
-                    alone: false,
+                    ..Prim::input(
+                        format!("{na} less {nb} through a lag"),
+                        format!("lag({a} - {b}, tau_s)"),
+                    )
+                    .led_by(format!("({a} - {b})"))
                 });
             }
         }
@@ -282,11 +353,14 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
         }
     }
     for (col, name, _) in temps.into_iter().filter(|(_, _, x)| moves(x)) {
-        p.push(Prim::input(
-            format!("{name} less 20 degC"),
-            format!("({col} - 20)"),
-        ));
-        p.push(Prim::input(format!("{name}'s rate"), format!("ddt({col})")));
+        p.push(
+            Prim::input(format!("{name} less 20 degC"), format!("({col} - 20)"))
+                .led_by(format!("ddt({col})")),
+        );
+        p.push(
+            Prim::input(format!("{name}'s rate"), format!("ddt({col})"))
+                .led_by(format!("d2dt2({col})")),
+        );
         p.push(Prim::input(
             format!("{name}'s curvature"),
             format!("d2dt2({col})"),
@@ -305,14 +379,15 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
         }
         if span / 4.0 > 2.0 * LAG_TAU_MIN_S {
             p.push(Prim {
-                label: format!("{name} through a lag"),
-                text: format!("(lag({col}, tau_s) - 20)"),
-                kind: PrimKind::Input,
                 searched: Some(Searched {
                     name: "tau_s",
                     grid: log_grid(LAG_TAU_MIN_S, span / 4.0, LAG_TAUS),
                 }),
-                alone: false,
+                ..Prim::input(
+                    format!("{name} through a lag"),
+                    format!("(lag({col}, tau_s) - 20)"),
+                )
+                .led_by(format!("({col} - 20)"))
             });
         }
     }
@@ -329,6 +404,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
             kind: PrimKind::Hours,
             searched: None,
             alone: false,
+            lead: None,
         });
         p.push(Prim {
             label: "a decay".into(),
@@ -339,6 +415,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                 grid: log_grid(60.0, span, PRODUCT_DECAYS),
             }),
             alone: false,
+            lead: None,
         });
         p.push(Prim {
             label: "a step".into(),
@@ -349,6 +426,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                 grid: onsets(t0, span, PRODUCT_ONSETS),
             }),
             alone: false,
+            lead: None,
         });
         if span >= 600.0 {
             p.push(Prim {
@@ -360,6 +438,7 @@ pub fn primitives(inp: &Inputs) -> Vec<Prim> {
                     grid: log_grid(300.0, span / 2.0, PRODUCT_PERIODS),
                 }),
                 alone: false,
+                lead: None,
             });
         }
     }
@@ -425,7 +504,38 @@ fn product(prims: &[Prim], recipe: Vec<Factor>) -> Candidate {
         parts,
         searched,
         recipe,
+        also: vec![],
+        second: None,
     }
+}
+
+/// `recipe`'s product beside the same product with its last factor
+/// replaced by `other`, each with its coefficient: the factor led (its
+/// lead primitive) or made a quadratic (its square). Any searched
+/// parameter is the two parts' one.
+fn paired(prims: &[Prim], recipe: &[Factor], other: Factor, what: Second) -> Candidate {
+    let mut first = product(prims, recipe.to_vec());
+    let mut second_recipe = recipe.to_vec();
+    *second_recipe.last_mut().expect("a factor") = other;
+    let second = product(prims, second_recipe);
+    let how = match what {
+        Second::Lead => "with a lead",
+        Second::Direct => "part of it direct",
+        Second::Square => "and its square",
+    };
+    first.label = format!("{}, {how}", first.label);
+    first.second = Some(what);
+    first.parts.push(Part {
+        coef: "k2_dph",
+        shape: second.parts[0].shape.clone(),
+    });
+    for s in second.searched {
+        if !first.searched.iter().any(|f| f.name == s.name) {
+            first.searched.push(s);
+        }
+    }
+    first.also.push(second.recipe);
+    first
 }
 
 /// The candidates a run's inputs can carry, with the primitives their
@@ -463,6 +573,34 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
                 if !even_abs(i, pi) && !even_abs(j, pj) {
                     c.push(product(&prims, vec![f(i, pi), f(j, pj)]));
                 }
+            }
+        }
+    }
+    // A temperature's primitive beside its lead, or beside its own square,
+    // by itself and times the rate (a bias, a scale factor): two
+    // coefficients on one primitive, so a lagged temperature's quadratic
+    // or a sensor that lags the physics is one candidate, not a term with
+    // a library name standing in for its other half.
+    let rate = inputs.iter().copied().find(|&i| prims[i].label == "rate");
+    for &i in &composable {
+        let Some(lead) = prims[i]
+            .lead
+            .as_ref()
+            .and_then(|l| prims.iter().position(|p| p.text == *l))
+        else {
+            continue;
+        };
+        let level = !prims[i].text.starts_with("ddt(");
+        for by in std::iter::once(None).chain(rate.map(Some)) {
+            let base: Vec<Factor> = by.map(|r| f(r, 1)).into_iter().chain([f(i, 1)]).collect();
+            let how = if prims[i].searched.is_some() {
+                Second::Direct
+            } else {
+                Second::Lead
+            };
+            c.push(paired(&prims, &base, f(lead, 1), how));
+            if level {
+                c.push(paired(&prims, &base, f(i, 2), Second::Square));
             }
         }
     }
@@ -521,6 +659,8 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
                 grid: on.clone(),
             }],
             recipe: vec![],
+            also: vec![],
+            second: None,
         });
         // Events searched in two parameters: a bias that settles after an
         // event (a mode hop, a relock, a heater switched: 0 before t1, k (1
@@ -546,6 +686,8 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
                 },
             ],
             recipe: vec![],
+            also: vec![],
+            second: None,
         });
         if span / 3.0 > 2.0 * SETTLING_TAU_MIN_S {
             let taus = log_grid(SETTLING_TAU_MIN_S, span / 3.0, SETTLING_TAUS);
@@ -578,6 +720,8 @@ pub fn candidates(inp: &Inputs) -> (Vec<Prim>, Vec<Candidate>) {
                         },
                     ],
                     recipe: vec![],
+                    also: vec![],
+                    second: None,
                 });
             }
         }

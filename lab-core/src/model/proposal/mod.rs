@@ -26,7 +26,7 @@ pub mod validation;
 
 use crate::model::inputs::Inputs;
 use crate::model::term::Term;
-use candidates::{candidates, space_size, Candidate};
+use candidates::{candidates, space_size, Candidate, Second};
 use orthogonal::{basis, dot, orthogonal};
 use refine::{jointly, on_grid, Scored};
 use refit::ToRows;
@@ -47,6 +47,38 @@ pub struct Proposed {
     /// two, and its coefficient, from their joint fit).
     pub intervals: BTreeMap<String, (f64, f64)>,
     pub validation: Validation,
+    /// The same term with a second part beside it (candidates.rs's
+    /// `paired`: its lead, or the lagged input direct), its label and the
+    /// term at the proposed values with the second coefficient at zero.
+    /// Where a library name stands in for that part (a scale factor over
+    /// temperature beside a lagged one), the name's pruning tries them
+    /// (discovery/outside.rs): the part already in the fit gained nothing
+    /// in the search.
+    pub variants: Vec<Variant>,
+}
+
+/// A proposed term with a second part: its label, the term, and what the
+/// part is (whose coefficients must stay plausible).
+pub type Variant = (String, Term, Second);
+
+/// The `paired` candidates that extend `c` (the same first part, one part
+/// more), as terms at `term`'s values with the new coefficient at zero.
+fn variants(c: &Candidate, term: &Term, paired: &[Candidate]) -> Vec<Variant> {
+    paired
+        .iter()
+        .filter(|p| p.recipe == c.recipe && c.also.is_empty() && c.parts.len() == 1)
+        .filter_map(|p| {
+            let mut params = term.params.clone();
+            for part in &p.parts[1..] {
+                params.insert(part.coef.to_string(), 0.0);
+            }
+            Some((
+                p.label.clone(),
+                Term::new(&p.formula(), params).ok()?,
+                p.second?,
+            ))
+        })
+        .collect()
 }
 
 /// A candidate's score.
@@ -136,6 +168,11 @@ pub fn propose(
     let space = space_size(&cands);
     let thr = threshold(space);
     let screen = Screen::new(inp, win, &prims);
+    let paired: Vec<Candidate> = cands
+        .iter()
+        .filter(|c| !c.also.is_empty())
+        .cloned()
+        .collect();
     let mut scored: Vec<Scored> = vec![];
     for c in cands {
         if n < 4 * FOLDS {
@@ -222,6 +259,7 @@ pub fn propose(
     let chosen = finalists
         .into_iter()
         .filter_map(|s| Some((s, fitted(s)?)))
+        .filter(|(s, f)| s.0.second.is_none_or(|k| k.plausible(&f.0.params)))
         .max_by(|(a, fa), (b, fb)| {
             let sa = fa.2 / var - pen * cost(&a.0);
             let sb = fb.2 / var - pen * cost(&b.0);
@@ -231,6 +269,7 @@ pub fn propose(
         let (gain, folds) = (s.3, &s.4);
         Proposed {
             label: s.0.label.clone(),
+            variants: variants(&s.0, &term, &paired),
             term,
             intervals,
             validation: Validation {
@@ -309,6 +348,103 @@ mod tests {
             "{:?}",
             got.validation
         );
+    }
+
+    /// A scale factor following the coil's temperature, read by a sensor
+    /// that lags it by a minute (a chamber swinging +-15 degC every 20
+    /// min): the term proposed is the sensor's temperature with a lead,
+    /// and the lead k2 / k is the sensor's lag.
+    #[test]
+    fn a_sensor_behind_the_physics_is_proposed_as_a_lead() {
+        let n = 7200;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 + 1.0).collect();
+        let w: Vec<f64> = (0..n)
+            .map(|k| [50.0, -50.0, 200.0, -200.0, 100.0, -100.0][(k / 300) % 6])
+            .collect();
+        let coil: Vec<f64> = t
+            .iter()
+            .map(|t| 25.0 + 15.0 * (2.0 * std::f64::consts::PI * t / 1200.0).sin())
+            .collect();
+        let (lag_s, a) = (60.0, 1.0 - (-1.0f64 / 60.0).exp());
+        let mut sensor = vec![coil[0]; n];
+        for k in 1..n {
+            sensor[k] = sensor[k - 1] + a * (coil[k] - sensor[k - 1]);
+        }
+        let inp = Inputs::new(t, w.clone(), Some(sensor), None, None, None);
+        let k = 1e-3;
+        let e = noise(n, 11);
+        let y: Vec<f64> = (0..n).map(|i| k * w[i] * (coil[i] - 20.0) + e[i]).collect();
+        let p = prop(&inp, &y, &constant(n), &|x| x.to_vec());
+        let got = p.proposed.expect("a term");
+        assert_eq!(
+            got.label,
+            "rate times temperature less 20 degC, with a lead",
+            "{:?}",
+            &p.tried[..3]
+        );
+        let lead = got.term.params["k2_dph"] / got.term.params["k_dph"];
+        assert!((lead - lag_s).abs() < 0.1 * lag_s, "lead {lead} s");
+        assert!((got.term.params["k_dph"] - k).abs() < 0.01 * k);
+    }
+
+    /// A bias quadratic in a temperature that reaches the gyro through a
+    /// 15 min lag (a chamber cycling +-15 degC every 50 min, the gyro at
+    /// rest): the lag and its square, each with its coefficient, the time
+    /// constant and the square's coefficient inside their intervals.
+    #[test]
+    fn a_bias_quadratic_in_a_lagged_temperature_is_one_candidate() {
+        let n = 7200;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 + 1.0).collect();
+        let temp: Vec<f64> = t
+            .iter()
+            .map(|t| 25.0 + 15.0 * (2.0 * std::f64::consts::PI * t / 3000.0).sin())
+            .collect();
+        let inp = Inputs::new(t, vec![0.0; n], Some(temp.clone()), None, None, None);
+        let (tau, a) = (900.0, 1.0 - (-1.0f64 / 900.0).exp());
+        let mut lagged = vec![temp[0]; n];
+        for k in 1..n {
+            lagged[k] = lagged[k - 1] + a * (temp[k] - lagged[k - 1]);
+        }
+        let e = noise(n, 12);
+        let y: Vec<f64> = (0..n)
+            .map(|i| 0.2 * (lagged[i] - 20.0) - 0.05 * (lagged[i] - 20.0).powi(2) + e[i])
+            .collect();
+        let p = prop(&inp, &y, &constant(n), &|x| x.to_vec());
+        let got = p.proposed.expect("a term");
+        assert_eq!(
+            got.label,
+            "temperature through a lag, and its square",
+            "{:?}",
+            &p.tried[..3]
+        );
+        let (lo, hi) = got.intervals["tau_s"];
+        assert!(lo < tau && tau < hi, "tau {lo} .. {hi}");
+        let (lo, hi) = got.intervals["k2_dph"];
+        assert!(lo < -0.05 && -0.05 < hi, "k2 {lo} .. {hi}");
+    }
+
+    /// What a pair stands for: a sensor behind the physics by minutes, a
+    /// share direct whose sensor lag is as short; not two shapes fitted
+    /// against each other.
+    #[test]
+    fn a_pair_is_plausible_only_as_what_it_stands_for() {
+        let at = |k: f64, k2: f64, tau: f64| {
+            BTreeMap::from([
+                ("k_dph".to_string(), k),
+                ("k2_dph".to_string(), k2),
+                ("tau_s".to_string(), tau),
+            ])
+        };
+        assert!(Second::Lead.plausible(&at(2.0, 120.0, 0.0)));
+        assert!(!Second::Lead.plausible(&at(2.0, -120.0, 0.0)));
+        assert!(!Second::Lead.plausible(&at(2.0, 2.0 * 1000.0, 0.0)));
+        // 4 % direct of a 10 min lag: a sensor 24 s behind.
+        assert!(Second::Direct.plausible(&at(-0.96, -0.04, 600.0)));
+        // The RLG's one monoblock less the case: 69 % direct of a 45 min
+        // lag, a sensor 31 min behind.
+        assert!(!Second::Direct.plausible(&at(0.123, 0.280, 2681.0)));
+        assert!(!Second::Direct.plausible(&at(-0.085, 0.298, 952.0)));
+        assert!(Second::Square.plausible(&at(1.0, -5.0, 0.0)));
     }
 
     #[test]

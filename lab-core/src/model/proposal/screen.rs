@@ -13,7 +13,7 @@
 //! (the table's rate steps between windows). The term proposed is then
 //! evaluated exactly, row by row, from its formula (mod.rs).
 
-use super::candidates::{Candidate, Prim, PrimKind};
+use super::candidates::{Candidate, Factor, Prim, PrimKind};
 use crate::model::discovery::windows::Windows;
 use crate::model::inputs::Inputs;
 use crate::model::term::Term;
@@ -82,10 +82,31 @@ impl<'a> Screen<'a> {
                 .map(|p| eval(&p.shape, params.clone(), &self.times))
                 .collect();
         }
-        let n = self.win.len();
-        let mut common = vec![1.0; n];
+        let (common, periodic) = self.product(prims, &c.recipe, &params)?;
+        let mut cols = match periodic {
+            Some(arg) => vec![
+                common.iter().zip(&arg).map(|(a, x)| a * x.sin()).collect(),
+                common.iter().zip(&arg).map(|(a, x)| a * x.cos()).collect(),
+            ],
+            None => vec![common],
+        };
+        for r in &c.also {
+            cols.push(self.product(prims, r, &params)?.0);
+        }
+        Some(cols)
+    }
+
+    /// A recipe's product of window means at `params`, with the argument
+    /// of its periodic factor apart (its sine and cosine are two parts).
+    fn product(
+        &self,
+        prims: &[Prim],
+        recipe: &[Factor],
+        params: &BTreeMap<String, f64>,
+    ) -> Option<(Vec<f64>, Option<Vec<f64>>)> {
+        let mut common = vec![1.0; self.win.len()];
         let mut periodic: Option<Vec<f64>> = None;
-        for f in &c.recipe {
+        for f in recipe {
             let p = &prims[f.prim];
             let x: Vec<f64> = match (&p.kind, &p.searched) {
                 (PrimKind::Input, None) => self.means[f.prim].clone()?,
@@ -103,12 +124,6 @@ impl<'a> Screen<'a> {
                 *a *= b.powi(f.power);
             }
         }
-        Some(match periodic {
-            Some(arg) => vec![
-                common.iter().zip(&arg).map(|(a, x)| a * x.sin()).collect(),
-                common.iter().zip(&arg).map(|(a, x)| a * x.cos()).collect(),
-            ],
-            None => vec![common],
-        })
+        Some((common, periodic))
     }
 }
