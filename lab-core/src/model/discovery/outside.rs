@@ -157,9 +157,10 @@ fn term_columns(t: &Term, inp: &Inputs, map: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec
 /// (and `extra`'s parameters), in the noise variances `prune` counts:
 /// the gap's 1 s means with `e` taken out and every other column refitted
 /// by least squares, less the gap now. No refit of them, linear in their
-/// parameters (a shape's parameters to first order), can leave less, so
-/// a name that saves several times its criterion by this bound is kept
-/// without running the library again.
+/// parameters (a shape's parameters to first order, and each term at its
+/// shape's parameters far off), can leave less, so a name that saves
+/// several times its criterion by this bound is kept without running the
+/// library again.
 fn saves_at_least(
     given: &Model,
     cur: &Discovery,
@@ -176,6 +177,21 @@ fn saves_at_least(
     if let Some(t) = extra {
         cols.extend(term_columns(t, inp, &map));
     }
+    for t in cur.model_after.terms.iter().chain(extra) {
+        // A shape's parameter may move far (a lag's time constant to none,
+        // where it is its input; a step's onset to the record's start,
+        // where it is a scale factor): the term at 0.01 to 100 times each.
+        for p in t.params.keys().filter(|p| !is_linear(t, p, inp)) {
+            for f in [0.01, 0.3, 3.0, 100.0] {
+                let mut u = t.clone();
+                u.params.insert(p.clone(), t.params[p] * f);
+                if let Ok(g) = u.evaluate(inp) {
+                    let g: Vec<f64> = g.iter().map(|v| v / 3600.0).collect();
+                    cols.push(map(&g));
+                }
+            }
+        }
+    }
     let q = basis(&cols);
     let r = gw.mean(&cur.residual_after);
     let c = gw.mean(&fx.effect.contribution(inp, &fx.params));
@@ -185,8 +201,7 @@ fn saves_at_least(
 }
 
 /// How many times its criterion [`saves_at_least`] must show a name to
-/// save before `prune` keeps it unasked (the library run again may also
-/// move a shape's parameters beyond first order).
+/// save before `prune` keeps it unasked.
 const SURELY: f64 = 3.0;
 
 /// Term `i` of `d`'s model fitted on `d`'s residual (its other terms and
