@@ -4,8 +4,9 @@
 //! each timed wall-clock and its peak memory read from the kernel's
 //! accounting of that one child (wait4), each checked to find the three.
 //! The same at 6, 24 and 72 h with a fourth effect outside the library (a
-//! bias following the coil's temperature through a 30 min lag): the
-//! search over the grammar's candidates runs, and the keys end `_term`.
+//! scale factor following the coil's temperature through a 1 h lag, beside
+//! the unlagged one): the search over the grammar's candidates runs, the
+//! term must be found, and the keys end `_term`.
 
 use anyhow::{bail, Context, Result};
 use std::path::Path;
@@ -49,7 +50,8 @@ pub fn costs(lab: &Path, dir: &Path) -> Result<serde_json::Value> {
          [[effect]]\nname = \"bias\"\nbias_dph = 0.2\n";
     let outside = format!(
         "{library}[[effect]]\nname = \"term\"\n\
-         formula = \"k_dph * (lag(temp_c, tau_s) - 20)\"\nk_dph = 0.02\ntau_s = 1800\n"
+         formula = \"k_dph * ref_rate_dps * (lag(temp_c, tau_s) - 20)\"\n\
+         k_dph = 0.001\ntau_s = 3600\n"
     );
     let truth = dir.join("bench-truth.toml");
     let truth_term = dir.join("bench-truth-term.toml");
@@ -96,9 +98,10 @@ pub fn costs(lab: &Path, dir: &Path) -> Result<serde_json::Value> {
         )?;
         let v: serde_json::Value =
             serde_json::from_str(text.lines().last().unwrap_or("{}")).context("discover's JSON")?;
-        let want = 3 + usize::from(with_term);
-        if v["found"].as_array().map_or(0, |f| f.len()) != want {
-            bail!("discover on {key} did not find the {want} hidden effects: {v}");
+        let found = v["found"].as_array().cloned().unwrap_or_default();
+        let terms = found.iter().filter(|f| f["effect"] == "term").count();
+        if found.len() != 3 + usize::from(with_term) || terms != usize::from(with_term) {
+            bail!("discover on {key} did not find the hidden effects: {v}");
         }
         j.insert(format!("{key}_s"), rounded(wall, 3).into());
         j.insert(format!("{key}_peak_mb"), rounded(mb, 1).into());

@@ -156,11 +156,9 @@ fn term_columns(t: &Term, inp: &Inputs, map: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec
 /// At least what library name `e` saves beside the rest of `cur`'s fit
 /// (and `extra`'s parameters), in the noise variances `prune` counts:
 /// the gap's 1 s means with `e` taken out and every other column refitted
-/// by least squares, less the gap now. No refit of them, linear in their
-/// parameters (a shape's parameters to first order, and each term at its
-/// shape's parameters far off), can leave less, so a name that saves
-/// several times its criterion by this bound is kept without running the
-/// library again.
+/// by least squares, less the gap now. No linear refit of them (a shape's
+/// parameters to first order, and each term's far off) leaves less, so a
+/// name saving several times its criterion by it is kept unasked.
 fn saves_at_least(
     given: &Model,
     cur: &Discovery,
@@ -177,10 +175,12 @@ fn saves_at_least(
     if let Some(t) = extra {
         cols.extend(term_columns(t, inp, &map));
     }
-    for t in cur.model_after.terms.iter().chain(extra) {
-        // A shape's parameter may move far (a lag's time constant to none,
-        // where it is its input; a step's onset to the record's start,
-        // where it is a scale factor): the term at 0.01 to 100 times each.
+    // A shape's parameter may move far (a lag's time constant to none,
+    // where it is its input; a step's onset to the record's start, where
+    // it is a scale factor): the term at 0.01 to 100 times each. A
+    // variant's (`extra`) are its term's, whose far moves the library run
+    // without the name has tried already.
+    for t in cur.model_after.terms.iter().filter(|_| extra.is_none()) {
         for p in t.params.keys().filter(|p| !is_linear(t, p, inp)) {
             for f in [0.01, 0.3, 3.0, 100.0] {
                 let mut u = t.clone();
