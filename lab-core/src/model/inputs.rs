@@ -77,7 +77,7 @@ pub fn centered_slope(t: &[f64], x: &[f64], half: f64) -> Vec<f64> {
             while hi < n && t[hi] <= t[k] + half {
                 hi += 1;
             }
-            let s: Vec<f64> = (0..5).map(|j| c[hi][j] - c[lo][j]).collect();
+            let s: [f64; 5] = std::array::from_fn(|j| c[hi][j] - c[lo][j]);
             let den = s[0] * s[2] - s[1] * s[1];
             if s[0] < 2.0 || den <= 1e-12 * s[0] * s[2].max(1e-300) {
                 0.0

@@ -159,6 +159,11 @@ fn found_section(r: &mut Report, d: &Discovery) {
             &rows,
         );
     }
+    if !d.dropped.is_empty() {
+        // A name that came in and went: beside a term that carries it, or
+        // by the selection's backward steps.
+        r.paragraph(&format!("Named, then dropped: {}.", d.dropped.join("; ")));
+    }
     if !d.carried.is_empty() {
         r.paragraph("Carried in the model written, not named:");
         let rows: Vec<Vec<String>> = d

@@ -389,7 +389,7 @@ fn prune(
                 None => "the proposed term".into(),
             };
             pruned.push(format!(
-                "{} (beside {by} it saves {:.1} noise variances, under the {:.1} a name of {dof} parameter(s) needs)",
+                "{} (beside {by}, it saves {:.1} noise variances, under the {:.1} a name of {dof} parameter(s) needs)",
                 e.name(),
                 saves,
                 asks
