@@ -324,6 +324,26 @@ mod tests {
         vec![vec![1.0; n]]
     }
 
+    /// `x` (one row a second) through a first-order lag of `tau` s,
+    /// starting settled.
+    fn lagged(x: &[f64], tau: f64) -> Vec<f64> {
+        let a = 1.0 - (-1.0 / tau).exp();
+        let mut out = vec![x[0]; x.len()];
+        for k in 1..x.len() {
+            out[k] = out[k - 1] + a * (x[k] - out[k - 1]);
+        }
+        out
+    }
+
+    /// The term proposed on white noise of one per row, which must be the
+    /// candidate `label`.
+    fn proposed_as(inp: &Inputs, y: &[f64], label: &str) -> Proposed {
+        let p = prop(inp, y, &constant(y.len()), &|x| x.to_vec());
+        let got = p.proposed.expect("a term");
+        assert_eq!(got.label, label, "{:?}", &p.tried[..3]);
+        got
+    }
+
     #[test]
     fn a_hidden_rate_squared_term_is_proposed_with_its_coefficient() {
         let n = 7200;
@@ -365,23 +385,12 @@ mod tests {
             .iter()
             .map(|t| 25.0 + 15.0 * (2.0 * std::f64::consts::PI * t / 1200.0).sin())
             .collect();
-        let (lag_s, a) = (60.0, 1.0 - (-1.0f64 / 60.0).exp());
-        let mut sensor = vec![coil[0]; n];
-        for k in 1..n {
-            sensor[k] = sensor[k - 1] + a * (coil[k] - sensor[k - 1]);
-        }
-        let inp = Inputs::new(t, w.clone(), Some(sensor), None, None, None);
+        let lag_s = 60.0;
+        let inp = Inputs::new(t, w.clone(), Some(lagged(&coil, lag_s)), None, None, None);
         let k = 1e-3;
         let e = noise(n, 11);
         let y: Vec<f64> = (0..n).map(|i| k * w[i] * (coil[i] - 20.0) + e[i]).collect();
-        let p = prop(&inp, &y, &constant(n), &|x| x.to_vec());
-        let got = p.proposed.expect("a term");
-        assert_eq!(
-            got.label,
-            "rate times temperature less 20 degC, with a lead",
-            "{:?}",
-            &p.tried[..3]
-        );
+        let got = proposed_as(&inp, &y, "rate times temperature less 20 degC, with a lead");
         let lead = got.term.params["k2_dph"] / got.term.params["k_dph"];
         assert!((lead - lag_s).abs() < 0.1 * lag_s, "lead {lead} s");
         assert!((got.term.params["k_dph"] - k).abs() < 0.01 * k);
@@ -400,23 +409,13 @@ mod tests {
             .map(|t| 25.0 + 15.0 * (2.0 * std::f64::consts::PI * t / 3000.0).sin())
             .collect();
         let inp = Inputs::new(t, vec![0.0; n], Some(temp.clone()), None, None, None);
-        let (tau, a) = (900.0, 1.0 - (-1.0f64 / 900.0).exp());
-        let mut lagged = vec![temp[0]; n];
-        for k in 1..n {
-            lagged[k] = lagged[k - 1] + a * (temp[k] - lagged[k - 1]);
-        }
+        let tau = 900.0;
+        let x: Vec<f64> = lagged(&temp, tau).iter().map(|v| v - 20.0).collect();
         let e = noise(n, 12);
         let y: Vec<f64> = (0..n)
-            .map(|i| 0.2 * (lagged[i] - 20.0) - 0.05 * (lagged[i] - 20.0).powi(2) + e[i])
+            .map(|i| 0.2 * x[i] - 0.05 * x[i].powi(2) + e[i])
             .collect();
-        let p = prop(&inp, &y, &constant(n), &|x| x.to_vec());
-        let got = p.proposed.expect("a term");
-        assert_eq!(
-            got.label,
-            "temperature through a lag, and its square",
-            "{:?}",
-            &p.tried[..3]
-        );
+        let got = proposed_as(&inp, &y, "temperature through a lag, and its square");
         let (lo, hi) = got.intervals["tau_s"];
         assert!(lo < tau && tau < hi, "tau {lo} .. {hi}");
         let (lo, hi) = got.intervals["k2_dph"];
