@@ -23,6 +23,7 @@ pub mod confirm;
 pub mod constant;
 pub mod design;
 pub mod estimates;
+pub mod fit_columns;
 pub mod likelihood;
 pub mod noise_floor;
 pub mod noise_model;

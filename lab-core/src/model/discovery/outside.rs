@@ -9,6 +9,7 @@
 //! A proposal is kept only where the gap after shrinks with it; the gap
 //! before stays the model given's.
 
+use super::fit_columns::{columns_of, saves_at_least, SURELY};
 use super::likelihood::{self, Problem};
 use super::noise_model::{NoiseModel, Whitener};
 use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
@@ -17,7 +18,6 @@ use super::select::THRESHOLD as NAME_THRESHOLD;
 use crate::model::effects::Effect;
 use crate::model::gyro_model::Model;
 use crate::model::inputs::Inputs;
-use crate::model::proposal::orthogonal::{basis, dot, orthogonal};
 use crate::model::proposal::refit::{fit_term, is_linear};
 use crate::model::proposal::{propose, Validation, Variant};
 use crate::model::term::Term;
@@ -97,112 +97,6 @@ fn fit_columns(
 ) -> Vec<Vec<f64>> {
     columns_of(given, d, inp, (skip, None), &|x| rows.dps(x))
 }
-
-/// The columns of `d`'s fit (as [`fit_columns`], but term `skip.0` and
-/// effect `skip.1`), per row in deg/s, each mapped by `map`.
-fn columns_of(
-    given: &Model,
-    d: &Discovery,
-    inp: &Inputs,
-    skip: (Option<usize>, Option<Effect>),
-    map: &dyn Fn(&[f64]) -> Vec<f64>,
-) -> Vec<Vec<f64>> {
-    let mut cols = vec![map(&vec![1.0; inp.len()])];
-    for e in d.model_after.effects.iter().skip(given.effects.len()) {
-        if Some(e.effect) == skip.1 {
-            continue;
-        }
-        let c0 = e.effect.contribution(inp, &e.params);
-        for (p, &v) in &e.params {
-            let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
-            let mut q = e.params.clone();
-            q.insert(p.clone(), v + h);
-            let c1 = e.effect.contribution(inp, &q);
-            let col: Vec<f64> = c1.iter().zip(&c0).map(|(a, b)| (a - b) / h).collect();
-            cols.push(map(&col));
-        }
-    }
-    for (i, t) in d.model_after.terms.iter().enumerate() {
-        if Some(i) != skip.0 {
-            cols.extend(term_columns(t, inp, map));
-        }
-    }
-    cols
-}
-
-/// A term's columns: its derivative in each parameter, per row in deg/s,
-/// each mapped by `map`.
-fn term_columns(t: &Term, inp: &Inputs, map: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec<Vec<f64>> {
-    let Ok(g0) = t.evaluate(inp) else {
-        return vec![];
-    };
-    let mut cols = vec![];
-    for (p, &v) in &t.params {
-        let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
-        let mut u = t.clone();
-        u.params.insert(p.clone(), v + h);
-        if let Ok(g1) = u.evaluate(inp) {
-            let col: Vec<f64> = g1
-                .iter()
-                .zip(&g0)
-                .map(|(a, b)| (a - b) / h / 3600.0)
-                .collect();
-            cols.push(map(&col));
-        }
-    }
-    cols
-}
-
-/// At least what library name `e` saves beside the rest of `cur`'s fit
-/// (and `extra`'s parameters), in the noise variances `prune` counts:
-/// the gap's 1 s means with `e` taken out and every other column refitted
-/// by least squares, less the gap now. No linear refit of them (a shape's
-/// parameters to first order, and each term's far off) leaves less, so a
-/// name saving several times its criterion by it is kept unasked.
-fn saves_at_least(
-    given: &Model,
-    cur: &Discovery,
-    e: Effect,
-    extra: Option<&Term>,
-    inp: &Inputs,
-) -> f64 {
-    let gw = &cur.gap_windows;
-    let map = |x: &[f64]| gw.mean(x);
-    let Some(fx) = cur.model_after.effects.iter().find(|x| x.effect == e) else {
-        return 0.0;
-    };
-    let mut cols = columns_of(given, cur, inp, (None, Some(e)), &map);
-    if let Some(t) = extra {
-        cols.extend(term_columns(t, inp, &map));
-    }
-    // A shape's parameter may move far (a lag's time constant to none,
-    // where it is its input; a step's onset to the record's start, where
-    // it is a scale factor): the term at 0.01 to 100 times each. A
-    // variant's (`extra`) are its term's, whose far moves the library run
-    // without the name has tried already.
-    for t in cur.model_after.terms.iter().filter(|_| extra.is_none()) {
-        for p in t.params.keys().filter(|p| !is_linear(t, p, inp)) {
-            for f in [0.01, 0.3, 3.0, 100.0] {
-                let mut u = t.clone();
-                u.params.insert(p.clone(), t.params[p] * f);
-                if let Ok(g) = u.evaluate(inp) {
-                    let g: Vec<f64> = g.iter().map(|v| v / 3600.0).collect();
-                    cols.push(map(&g));
-                }
-            }
-        }
-    }
-    let q = basis(&cols);
-    let r = gw.mean(&cur.residual_after);
-    let c = gw.mean(&fx.effect.contribution(inp, &fx.params));
-    let without = orthogonal(r.iter().zip(&c).map(|(a, b)| a + b).collect(), &q);
-    let floor = cur.noise_floor_dph / 3600.0;
-    (dot(&without, &without) - dot(&r, &r)) / (floor * floor).max(1e-300)
-}
-
-/// How many times its criterion [`saves_at_least`] must show a name to
-/// save before `prune` keeps it unasked.
-const SURELY: f64 = 3.0;
 
 /// Term `i` of `d`'s model fitted on `d`'s residual (its other terms and
 /// effects carried), `free` its parameters let move.
@@ -316,10 +210,10 @@ fn refitted_without(
 /// effect in its place, the name stays.
 ///
 /// Where the term alone cannot take the name's place, its variants with
-/// a second part are asked (the term led, or its lagged input part
-/// direct: a sensor that lags the physics makes a lagged effect look
-/// like a lag plus an unlagged scale factor); one that lets the name go
-/// replaces the term and its label (`meta`).
+/// a second part are asked (the term led, its lagged input part direct,
+/// or its square: a sensor that lags the physics makes a lagged effect
+/// look like a lag plus an unlagged scale factor); one that lets the name
+/// go replaces the term and its label (`meta`).
 fn prune(
     given: &Model,
     mut m: Model,
@@ -329,6 +223,7 @@ fn prune(
     (meta, variants): (&mut [ProposedMeta], &[Vec<Variant>]),
 ) -> (Discovery, Vec<String>) {
     let mut pruned = vec![];
+    let mut replaced = vec![false; variants.len()];
     // The gap's windows (1 s means), which the gaps are the RMS of.
     let n1 = cur.gap_windows.len() as f64;
     let mut o = *opts;
@@ -353,29 +248,34 @@ fn prune(
             (saves, saves < asks && fewer)
         };
         let ctx = (run, &o2, discover_library);
-        let surely = |extra: Option<&Term>| {
+        let surely = |extra: (Option<&Term>, Option<usize>)| {
             saves_at_least(given, &cur, e, extra, &run.inputs) > SURELY * asks
         };
         let (mut saves, mut drop, mut chosen) = (f64::NAN, false, None);
-        if !surely(None) {
+        let ran = !surely((None, None));
+        if ran {
             let (m2, d) = refitted_without(given, &m, None, ctx, users);
             (saves, drop) = judge(&d);
             chosen = Some((m2, d, None));
         }
         if !drop {
-            'variants: for (k, vs) in variants.iter().enumerate() {
+            // A term replaced by a variant already is not asked again (its
+            // other variants would drop the part the name went for).
+            'variants: for (k, vs) in variants.iter().enumerate().filter(|(k, _)| !replaced[*k]) {
                 for (label, v, second) in vs {
                     // At the term's present values, its new part at zero.
                     let mut v = v.clone();
                     for (p, x) in &m.terms[users + k].params {
                         v.params.insert(p.clone(), *x);
                     }
-                    if surely(Some(&v)) {
+                    if surely((Some(&v), ran.then_some(users + k))) {
                         continue;
                     }
                     let (m3, d3) = refitted_without(given, &m, Some((users + k, &v)), ctx, users);
                     let (s3, ok) = judge(&d3);
-                    if ok && second.plausible(&m3.terms[users + k].params) {
+                    // Refitted: a second part left at zero is the term.
+                    let t3 = &m3.terms[users + k].params;
+                    if ok && t3.get("k2_dph").is_some_and(|&x| x != 0.0) && second.plausible(t3) {
                         (saves, drop) = (s3, true);
                         chosen = Some((m3, d3, Some((k, label.clone()))));
                         break 'variants;
@@ -396,6 +296,7 @@ fn prune(
             ));
             if let Some((k, l)) = relabel {
                 meta[k].0 = l;
+                replaced[k] = true;
             }
             (m, cur, o) = (m2, d, o2);
         }

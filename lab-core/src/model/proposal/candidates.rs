@@ -198,7 +198,8 @@ impl Candidate {
     }
 
     /// How composed it is: its factors' powers summed (a primitive 1, a
-    /// square or a product 2), the simpler preferred among equals.
+    /// square or a product 2; of a pair, its more composed part's), the
+    /// simpler preferred among equals.
     pub fn order(&self) -> i32 {
         std::iter::once(&self.recipe)
             .chain(&self.also)

@@ -48,7 +48,7 @@ pub struct Proposed {
     pub intervals: BTreeMap<String, (f64, f64)>,
     pub validation: Validation,
     /// The same term with a second part beside it (candidates.rs's
-    /// `paired`: its lead, or the lagged input direct), its label and the
+    /// `paired`: its lead, its square, or the lagged input direct), its label and the
     /// term at the proposed values with the second coefficient at zero.
     /// Where a library name stands in for that part (a scale factor over
     /// temperature beside a lagged one), the name's pruning tries them
@@ -217,8 +217,6 @@ pub fn propose(
     // searched in two parameters wins only where it explains clearly more
     // than a simpler shape (a step whose onset falls between two of the
     // coarse grid's is refined before it is compared).
-    let top = scored.iter().map(|s| s.3).fold(f64::NEG_INFINITY, f64::max);
-    let margin = (0.03 * top).max(2.0 * (top / var).max(0.0).sqrt() * var);
     let pen = (n as f64).ln();
     let grid_red = |s: &Scored| {
         s.1.iter()
@@ -226,29 +224,10 @@ pub fn propose(
             .map(|f| f.1)
             .fold(f64::NEG_INFINITY, f64::max)
     };
-    let mut finalists: Vec<&Scored> = scored
-        .iter()
-        .filter(|s| s.3 >= top - margin && s.3 / var >= thr)
-        .collect();
     // A composition is a choice among many: each order beyond a
     // primitive costs as a freedom does.
     let cost = |c: &Candidate| (c.freedom() as i32 + c.order() - 1) as f64;
     let coarse = |s: &Scored| grid_red(s) / var - pen * cost(&s.0);
-    finalists.sort_by(|a, b| coarse(b).total_cmp(&coarse(a)));
-    finalists.truncate(FINALISTS);
-    // The events searched in two parameters that pass the threshold join
-    // them, the best two by gain, however far behind: on the coarse grid
-    // an onset a grid spacing off the event's costs it most of its gain
-    // where the noise model whitens by differences (a random walk), while
-    // a smooth shape that misses the jump itself does not pay that, and
-    // only the refinement (jointly) puts the onset where it belongs.
-    let mut events: Vec<&Scored> = scored
-        .iter()
-        .filter(|s| s.0.searched.len() == 2 && s.3 / var >= thr)
-        .filter(|s| !finalists.iter().any(|f| std::ptr::eq(*f, *s)))
-        .collect();
-    events.truncate(2);
-    finalists.extend(events);
     let fitted = |s: &Scored| {
         if s.0.searched.len() > 1 {
             jointly(s, inp, y, fit, to_rows, var)
@@ -256,15 +235,47 @@ pub fn propose(
             on_grid(s, inp, y, to_rows, &q, var)
         }
     };
-    let chosen = finalists
-        .into_iter()
-        .filter_map(|s| Some((s, fitted(s)?)))
-        .filter(|(s, f)| s.0.second.is_none_or(|k| k.plausible(&f.0.params)))
-        .max_by(|(a, fa), (b, fb)| {
-            let sa = fa.2 / var - pen * cost(&a.0);
-            let sb = fb.2 / var - pen * cost(&b.0);
-            sa.total_cmp(&sb).then(b.0.order().cmp(&a.0.order()))
-        });
+    // The choice among the candidates `pool` lets in.
+    let choose = |pool: &dyn Fn(&Scored) -> bool| {
+        let top = scored
+            .iter()
+            .filter(|s| pool(s))
+            .map(|s| s.3)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let margin = (0.03 * top).max(2.0 * (top / var).max(0.0).sqrt() * var);
+        let mut finalists: Vec<&Scored> = scored
+            .iter()
+            .filter(|s| pool(s) && s.3 >= top - margin && s.3 / var >= thr)
+            .collect();
+        finalists.sort_by(|a, b| coarse(b).total_cmp(&coarse(a)));
+        finalists.truncate(FINALISTS);
+        // The events searched in two parameters that pass the threshold
+        // join them, the best two by gain, however far behind: on the
+        // coarse grid an onset a grid spacing off the event's costs it
+        // most of its gain where the noise model whitens by differences
+        // (a random walk), while a smooth shape that misses the jump
+        // itself does not pay that, and only the refinement (jointly)
+        // puts the onset where it belongs.
+        let mut events: Vec<&Scored> = scored
+            .iter()
+            .filter(|s| pool(s) && s.0.searched.len() == 2 && s.3 / var >= thr)
+            .filter(|s| !finalists.iter().any(|f| std::ptr::eq(*f, *s)))
+            .collect();
+        events.truncate(2);
+        finalists.extend(events);
+        finalists
+            .into_iter()
+            .filter_map(|s| Some((s, fitted(s)?)))
+            .filter(|(s, f)| s.0.second.is_none_or(|k| k.plausible(&f.0.params)))
+            .max_by(|(a, fa), (b, fb)| {
+                let sa = fa.2 / var - pen * cost(&a.0);
+                let sb = fb.2 / var - pen * cost(&b.0);
+                sa.total_cmp(&sb).then(b.0.order().cmp(&a.0.order()))
+            })
+    };
+    // Where every finalist was a pair that did not stay what it stands
+    // for, and it had set the margin, the choice again without the pairs.
+    let chosen = choose(&|_| true).or_else(|| choose(&|s| s.0.second.is_none()));
     let proposed = chosen.map(|(s, (term, intervals, _))| {
         let (gain, folds) = (s.3, &s.4);
         Proposed {
