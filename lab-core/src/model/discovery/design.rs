@@ -15,7 +15,7 @@ use crate::model::inputs::Inputs;
 use crate::model::ranges::Extent;
 use crate::numerics::dot::sum_sq;
 use crate::numerics::search::{golden, grid_then_golden};
-use std::cell::{Cell, RefCell};
+use std::cell::{Cell, OnceCell, RefCell};
 use std::collections::HashMap;
 use std::rc::Rc;
 
@@ -57,9 +57,20 @@ pub struct Design<'a> {
     /// [`OFF_GRID_CACHE_BYTES`], emptied when full).
     off_grid: RefCell<HashMap<(String, u64), Rc<Whitened>>>,
     off_grid_bytes: Cell<usize>,
+    /// What the noise model does not change, shared by every pass's design.
+    shared: Rc<Unwhitened>,
+}
+
+/// What a run's designs share, whatever their noise model: the fixed
+/// terms' window means (a shape's filtered derivatives cost the rows, so
+/// a 10 Hz record would pay for them again at every pass), the searches'
+/// grids, and the knee's sums.
+struct Unwhitened {
+    fixed: OnceCell<Vec<(Kind, Raw)>>,
+    grids: RefCell<HashMap<String, (Vec<f64>, bool)>>,
     /// Per window, what the knee's column needs (made on its first use):
     /// see [`KneeSums`].
-    knee: RefCell<Option<Rc<KneeSums>>>,
+    knee: RefCell<Option<Option<Rc<KneeSums>>>>,
 }
 
 /// The scale-factor knee's column, w (T - knee)+ averaged over each
@@ -181,7 +192,58 @@ impl<'a> Design<'a> {
         wh: Whitener,
         steps: Vec<f64>,
     ) -> Self {
-        let mut d = Self {
+        let shared = Rc::new(Unwhitened {
+            fixed: OnceCell::new(),
+            grids: RefCell::new(HashMap::new()),
+            knee: RefCell::new(None),
+        });
+        let mut d = Self::whitened_with(inp, win, extent, r, wh, steps, shared);
+        let mut kinds = vec![Kind::Constant];
+        kinds.extend(
+            Effect::ALL
+                .into_iter()
+                .filter(|e| e.nonlinear_param().is_none() && e.available(inp))
+                .map(Kind::Effect),
+        );
+        kinds.extend(
+            Shape::ALL
+                .into_iter()
+                .filter(|s| s.available(inp))
+                .map(Kind::Shape),
+        );
+        let fixed = kinds.iter().map(|k| (*k, d.raw(&Term::of(*k)))).collect();
+        let _ = d.shared.fixed.set(fixed);
+        d.whiten_fixed();
+        d
+    }
+
+    /// The same run's problem under another noise model (and steps): the
+    /// fixed terms' window means, the grids and the knee's sums are
+    /// reused, only the whitening is new.
+    pub fn renoised(&self, wh: Whitener, steps: Vec<f64>) -> Self {
+        let mut d = Self::whitened_with(
+            self.inp,
+            self.win,
+            self.extent,
+            self.r.clone(),
+            wh,
+            steps,
+            self.shared.clone(),
+        );
+        d.whiten_fixed();
+        d
+    }
+
+    fn whitened_with(
+        inp: &'a Inputs,
+        win: &'a Windows,
+        extent: Extent,
+        r: Vec<f64>,
+        wh: Whitener,
+        steps: Vec<f64>,
+        shared: Rc<Unwhitened>,
+    ) -> Self {
+        Self {
             inp,
             win,
             extent,
@@ -196,36 +258,26 @@ impl<'a> Design<'a> {
             grid_bytes: Cell::new(0),
             off_grid: RefCell::new(HashMap::new()),
             off_grid_bytes: Cell::new(0),
-            knee: RefCell::new(None),
-        };
-        let mut kinds = vec![Kind::Constant];
-        kinds.extend(
-            Effect::ALL
-                .into_iter()
-                .filter(|e| e.nonlinear_param().is_none() && e.available(inp))
-                .map(Kind::Effect),
-        );
-        kinds.extend(
-            Shape::ALL
-                .into_iter()
-                .filter(|s| s.available(inp))
-                .map(Kind::Shape),
-        );
-        // The residual and every fixed column whitened together.
-        let raws: Vec<Raw> = kinds.iter().map(|k| d.raw(&Term::of(*k))).collect();
-        let mut all: Vec<&[f64]> = vec![&d.r];
-        for raw in &raws {
+            shared,
+        }
+    }
+
+    /// The residual and every fixed column whitened together.
+    fn whiten_fixed(&mut self) {
+        let shared = self.shared.clone();
+        let fixed = shared.fixed.get().map_or(&[][..], Vec::as_slice);
+        let mut all: Vec<&[f64]> = vec![&self.r];
+        for (_, raw) in fixed {
             all.extend(raw.cols.iter().map(Vec::as_slice));
             all.extend(raw.offset.as_deref());
         }
-        let mut w = d.wh.whiten_many(&all).into_iter();
-        d.y = w.next().unwrap_or_default();
-        for (k, raw) in kinds.iter().zip(&raws) {
+        let mut w = self.wh.whiten_many(&all).into_iter();
+        self.y = w.next().unwrap_or_default();
+        for (k, raw) in fixed {
             let cols = w.by_ref().take(raw.cols.len()).collect();
             let offset = raw.offset.as_ref().and_then(|_| w.next());
-            d.fixed.insert(key(*k), (cols, offset));
+            self.fixed.insert(key(*k), (cols, offset));
         }
-        d
     }
 
     /// Windows used by the fit.
@@ -301,11 +353,12 @@ impl<'a> Design<'a> {
 
     /// The knee's sums, made on first use (None without a temperature).
     fn knee_sums(&self) -> Option<Rc<KneeSums>> {
-        if self.knee.borrow().is_none() {
+        let knee = &self.shared.knee;
+        if knee.borrow().is_none() {
             let k = KneeSums::new(self.inp, self.win).map(Rc::new);
-            *self.knee.borrow_mut() = k;
+            *knee.borrow_mut() = Some(k);
         }
-        self.knee.borrow().clone()
+        knee.borrow().clone().flatten()
     }
 
     fn whiten_raw(&self, raw: &Raw) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
@@ -495,7 +548,16 @@ impl<'a> Design<'a> {
     /// steps offered.
     fn grid(&self, t: &Term) -> (Vec<f64>, bool) {
         match t.kind {
-            Kind::Effect(e) => (e.search_grid(self.inp), e.search_log()),
+            Kind::Effect(e) => {
+                // An effect's grid reads the rows: made once per run.
+                let k = key(t.kind);
+                if let Some(g) = self.shared.grids.borrow().get(&k) {
+                    return g.clone();
+                }
+                let g = (e.search_grid(self.inp), e.search_log());
+                self.shared.grids.borrow_mut().insert(k, g.clone());
+                g
+            }
             Kind::Periodic => {
                 let n = self.win.t.len();
                 let span = if n > 1 {

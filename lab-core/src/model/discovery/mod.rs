@@ -270,16 +270,8 @@ fn passes<'a>(
         WINDOW_S
     };
     let noise_a = NoiseModel::from_residual(&e1, &keep, tau0);
-    let design = |noise: &NoiseModel| {
-        Design::new(
-            inp,
-            win,
-            x,
-            rw.to_vec(),
-            Whitener::new(noise, win, &keep),
-            tr.steps.clone(),
-        )
-    };
+    let design =
+        |noise: &NoiseModel| d1.renoised(Whitener::new(noise, win, &keep), tr.steps.clone());
     let d2 = design(&noise_a);
     let sel2 = select(&d2, cands, excluded);
     // The noise's slow levels by maximum likelihood given what the second
@@ -342,14 +334,7 @@ fn allow_slow_noise(
         if up == *noise {
             continue;
         }
-        let mut du = Design::new(
-            d.inp,
-            d.win,
-            d.extent,
-            d.r.clone(),
-            Whitener::new(&up, d.win, &d.wh.keep),
-            d.steps.clone(),
-        );
+        let mut du = d.renoised(Whitener::new(&up, d.win, &d.wh.keep), d.steps.clone());
         du.phi = d.phi;
         if let Some(f) = estimate(&du, terms) {
             estimates::widen(fin, &f);
