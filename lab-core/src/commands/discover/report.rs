@@ -313,7 +313,7 @@ fn unexplained_section(r: &mut Report, d: &Discovery) {
          carried by {}.",
         num(u.excess_dph),
         gap_means_text(d),
-        u.carried_by.join("; ")
+        u.carried_text()
     ));
     if !u.spans.is_empty() {
         let rows: Vec<Vec<String>> = u
@@ -522,7 +522,7 @@ fn verdict(d: &Discovery) -> Verdict {
             v.text("Left unexplained: ")
                 .num("unexplained.excess_dph", u.excess_dph, 4)
                 .text(" deg/h above the noise, carried by ")
-                .text(&u.carried_by.join("; "));
+                .text(&u.carried_text());
             if let (Some(a), Some(b)) = (u.spans.first(), u.spans.last()) {
                 v.text(&format!(
                     ", in {} span(s) from {} s to {} s",

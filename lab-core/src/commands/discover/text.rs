@@ -134,7 +134,7 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
             out.push(format!(
                 "no effect of the library explains this: {:.4} deg/h above the noise ({})",
                 u.excess_dph,
-                u.carried_by.join("; ")
+                u.carried_text()
             ));
             for s in u.spans.iter().take(8) {
                 out.push(format!(

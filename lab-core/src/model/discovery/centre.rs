@@ -86,7 +86,9 @@ pub fn centre(run: &Run, mut d: Discovery, window_s: f64) -> Discovery {
     if moved {
         d.residual_after.iter_mut().for_each(|r| *r -= mean);
         d.gap_after_dph = gap(&d.gap_windows, &d.residual_after);
-        d.centred_by_dph = by;
+        // Centred twice (each library run the search compared, then the
+        // result): the moves add.
+        d.centred_by_dph += by;
     }
     let after = d.gap_windows.mean(&d.residual_after);
     d.residual_mean_dph = after.iter().sum::<f64>() / after.len() as f64 * 3600.0;

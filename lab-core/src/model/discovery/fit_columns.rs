@@ -3,6 +3,7 @@
 //! least-squares bound on what a library name saves beside the proposed
 //! terms (outside.rs's `prune` skips the library runs it makes needless).
 
+use super::normal::normal_solve;
 use super::result::Discovery;
 use crate::model::effects::Effect;
 use crate::model::gyro_model::Model;
@@ -10,6 +11,55 @@ use crate::model::inputs::Inputs;
 use crate::model::proposal::orthogonal::{basis, dot, orthogonal};
 use crate::model::proposal::refit::is_linear;
 use crate::model::term::Term;
+use std::collections::BTreeMap;
+
+/// Per row, the derivative of `f` in each parameter of `params` that
+/// `keep` lets through, by a forward difference, in deg/s (`per_dps` of
+/// `f`'s unit make a deg/s: 3600 for deg/h), each mapped by `map`.
+fn derivatives(
+    params: &BTreeMap<String, f64>,
+    f: &dyn Fn(&BTreeMap<String, f64>) -> Option<Vec<f64>>,
+    (keep, per_dps): (&dyn Fn(&str) -> bool, f64),
+    map: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let Some(f0) = f(params) else {
+        return vec![];
+    };
+    let mut cols = vec![];
+    for (p, &v) in params.iter().filter(|(p, _)| keep(p)) {
+        let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
+        let mut q = params.clone();
+        q.insert(p.clone(), v + h);
+        if let Some(f1) = f(&q) {
+            let col: Vec<f64> = f1
+                .iter()
+                .zip(&f0)
+                .map(|(a, b)| (a - b) / h / per_dps)
+                .collect();
+            cols.push(map(&col));
+        }
+    }
+    cols
+}
+
+/// The constant and every parameter of the effects `d` added to `given`
+/// but `skip`, per row in deg/s, each mapped by `map`.
+fn effect_columns(
+    given: &Model,
+    d: &Discovery,
+    inp: &Inputs,
+    skip: Option<Effect>,
+    map: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let mut cols = vec![map(&vec![1.0; inp.len()])];
+    for e in d.model_after.effects.iter().skip(given.effects.len()) {
+        if Some(e.effect) != skip {
+            let f = |q: &BTreeMap<String, f64>| Some(e.effect.contribution(inp, q));
+            cols.extend(derivatives(&e.params, &f, (&|_| true, 1.0), map));
+        }
+    }
+    cols
+}
 
 /// The columns of `d`'s fit (outside.rs's `fit_columns`, but term `skip.0` and
 /// effect `skip.1`), per row in deg/s, each mapped by `map`.
@@ -20,21 +70,7 @@ pub fn columns_of(
     skip: (Option<usize>, Option<Effect>),
     map: &dyn Fn(&[f64]) -> Vec<f64>,
 ) -> Vec<Vec<f64>> {
-    let mut cols = vec![map(&vec![1.0; inp.len()])];
-    for e in d.model_after.effects.iter().skip(given.effects.len()) {
-        if Some(e.effect) == skip.1 {
-            continue;
-        }
-        let c0 = e.effect.contribution(inp, &e.params);
-        for (p, &v) in &e.params {
-            let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
-            let mut q = e.params.clone();
-            q.insert(p.clone(), v + h);
-            let c1 = e.effect.contribution(inp, &q);
-            let col: Vec<f64> = c1.iter().zip(&c0).map(|(a, b)| (a - b) / h).collect();
-            cols.push(map(&col));
-        }
-    }
+    let mut cols = effect_columns(given, d, inp, skip.1, map);
     for (i, t) in d.model_after.terms.iter().enumerate() {
         if Some(i) != skip.0 {
             cols.extend(term_columns(t, inp, map));
@@ -43,27 +79,71 @@ pub fn columns_of(
     cols
 }
 
+/// A term's derivatives in the parameters `keep` lets through, per row in
+/// deg/s, each mapped by `map`.
+fn term_derivatives(
+    t: &Term,
+    inp: &Inputs,
+    keep: &dyn Fn(&str) -> bool,
+    map: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let f = |q: &BTreeMap<String, f64>| {
+        let mut u = t.clone();
+        u.params = q.clone();
+        u.evaluate(inp).ok()
+    };
+    derivatives(&t.params, &f, (keep, 3600.0), map)
+}
+
 /// A term's columns: its derivative in each parameter, per row in deg/s,
 /// each mapped by `map`.
 pub fn term_columns(t: &Term, inp: &Inputs, map: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec<Vec<f64>> {
-    let Ok(g0) = t.evaluate(inp) else {
-        return vec![];
-    };
-    let mut cols = vec![];
-    for (p, &v) in &t.params {
-        let h = if v != 0.0 { 1e-4 * v.abs() } else { 1e-6 };
-        let mut u = t.clone();
-        u.params.insert(p.clone(), v + h);
-        if let Ok(g1) = u.evaluate(inp) {
-            let col: Vec<f64> = g1
-                .iter()
-                .zip(&g0)
-                .map(|(a, b)| (a - b) / h / 3600.0)
-                .collect();
-            cols.push(map(&col));
-        }
+    term_derivatives(t, inp, &|_| true, map)
+}
+
+/// The terms of `d`'s model from `from` on, their linear coefficients
+/// fitted jointly (each term's other parameters held, the effects and the
+/// earlier terms carried) on the residual whitened by `map`. A term added
+/// after another is fitted beside the first held at its value, and two
+/// terms on one input (a temperature's square and its cube) are as
+/// correlated as their coefficients are: held, the first keeps what the
+/// second should take. None where the fit is degenerate or nothing moves.
+pub fn jointly_linear(
+    given: &Model,
+    d: &Discovery,
+    inp: &Inputs,
+    from: usize,
+    map: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Option<Vec<Term>> {
+    let terms = &d.model_after.terms;
+    let mut carried = effect_columns(given, d, inp, None, map);
+    for t in terms.iter().take(from) {
+        carried.extend(term_columns(t, inp, map));
     }
-    cols
+    let q = basis(&carried);
+    let mut cols = vec![];
+    let mut which = vec![];
+    for (i, t) in terms.iter().enumerate().skip(from) {
+        let linear = |p: &str| is_linear(t, p, inp);
+        for p in t.params.keys().filter(|p| linear(p)) {
+            which.push((i, p.clone()));
+        }
+        cols.extend(term_derivatives(t, inp, &linear, map));
+    }
+    if cols.is_empty() || cols.len() != which.len() {
+        return None;
+    }
+    let cols: Vec<Vec<f64>> = cols.into_iter().map(|c| orthogonal(c, &q)).collect();
+    let y = orthogonal(map(&d.residual_after), &q);
+    let step = normal_solve(&cols, &y)?;
+    if step.iter().any(|s| !s.is_finite()) || step.iter().all(|s| *s == 0.0) {
+        return None;
+    }
+    let mut out: Vec<Term> = terms[from..].to_vec();
+    for ((i, p), s) in which.iter().zip(&step) {
+        *out[i - from].params.get_mut(p)? += s;
+    }
+    Some(out)
 }
 
 /// At least what library name `e` saves beside the rest of `cur`'s fit
@@ -93,12 +173,10 @@ pub fn saves_at_least(
     // it is a scale factor): the term at 0.01 to 100 times each; but term
     // `near`'s, a variant's own, whose far moves the library run without
     // the name has tried.
-    for (_, t) in cur
-        .model_after
-        .terms
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| Some(*i) != near)
+    let terms = &cur.model_after.terms;
+    for t in (0..terms.len())
+        .filter(|i| Some(*i) != near)
+        .map(|i| &terms[i])
     {
         for p in t.params.keys().filter(|p| !is_linear(t, p, inp)) {
             for f in [0.01, 0.3, 3.0, 100.0] {

@@ -9,7 +9,7 @@
 //! A proposal is kept only where the gap after shrinks with it; the gap
 //! before stays the model given's.
 
-use super::fit_columns::{columns_of, saves_at_least, SURELY};
+use super::fit_columns::{columns_of, jointly_linear, saves_at_least, SURELY};
 use super::likelihood::{self, Problem};
 use super::noise_model::{NoiseModel, Whitener};
 use super::result::{Discovery, Options, Proposals, Run, TermFound, NOT_SIGNIFICANT};
@@ -146,6 +146,39 @@ fn settle(
     m3.terms[i] = f.term;
     let again = discover_library(&m3, run, opts);
     if again.gap_after_dph < next.gap_after_dph {
+        (m3, again)
+    } else {
+        (m2, next)
+    }
+}
+
+/// With two terms or more proposed, their linear coefficients fitted
+/// jointly (fit_columns.rs `jointly_linear`) and the library run again on
+/// them, where that shrinks the gap: [`settle`] fits the newest beside the
+/// earlier held.
+fn jointly(
+    given: &Model,
+    m2: Model,
+    next: Discovery,
+    (run, opts, discover_library): (&Run, &Options, Library),
+    users: usize,
+) -> (Model, Discovery) {
+    if m2.terms.len() < users + 2 {
+        return (m2, next);
+    }
+    let rows = Rows::new(&next);
+    let Some(ts) = jointly_linear(given, &next, &run.inputs, users, &|x| rows.dps(x)) else {
+        return (m2, next);
+    };
+    let mut m3 = m2.clone();
+    m3.terms.truncate(users);
+    m3.terms.extend(ts);
+    let again = discover_library(&m3, run, opts);
+    // The coefficients moved, not what the library names: a name the
+    // joint fit brings in is one the terms' coefficients make room for.
+    let names = |d: &Discovery| -> Vec<Effect> { d.found.iter().map(|f| f.effect).collect() };
+    let (was, now) = (names(&next), names(&again));
+    if again.gap_after_dph < next.gap_after_dph && now.iter().all(|e| was.contains(e)) {
         (m3, again)
     } else {
         (m2, next)
@@ -522,6 +555,7 @@ pub fn beyond(
             m2.terms.push(pr.term.clone());
             let next = discover_library(&m2, run, opts);
             let (m2, next) = settle(given, m2, next, run, opts, discover_library);
+            let (m2, next) = jointly(given, m2, next, (run, opts, discover_library), users);
             // What stood above the floor, and what of it the term closed:
             // a term that predicts a little of a residual it cannot
             // explain (a slow wander the noise model misread) is not the

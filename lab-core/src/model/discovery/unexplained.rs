@@ -52,6 +52,18 @@ pub struct Unexplained {
     pub input_function: Option<String>,
 }
 
+impl Unexplained {
+    /// What carries it, said: the shapes and spikes, or, where none is
+    /// named (the excess stands in its spans alone), that.
+    pub fn carried_text(&self) -> String {
+        if self.carried_by.is_empty() {
+            "no shape the fit names (see its spans)".into()
+        } else {
+            self.carried_by.join("; ")
+        }
+    }
+}
+
 /// The unexplained part, one value per window, from its sources.
 pub struct Sources<'a> {
     /// The nuisance terms' parts (window means, deg/s) and their names.
