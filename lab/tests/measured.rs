@@ -44,11 +44,14 @@ fn residual(x: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
             .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
             .unwrap();
         a.swap(k, p);
-        for i in k + 1..m {
-            let f = a[i][k] / a[k][k];
-            for j in k..=m {
-                a[i][j] -= f * a[k][j];
-            }
+        let (top, rest) = a.split_at_mut(k + 1);
+        let pivot = &top[k];
+        for row in rest {
+            let f = row[k] / pivot[k];
+            row.iter_mut()
+                .zip(pivot)
+                .skip(k)
+                .for_each(|(x, p)| *x -= f * p);
         }
     }
     let mut c = vec![0.0; m];

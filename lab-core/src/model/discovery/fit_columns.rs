@@ -13,12 +13,16 @@ use crate::model::proposal::refit::is_linear;
 use crate::model::term::Term;
 use std::collections::BTreeMap;
 
+/// A contribution per row at the parameters given (None where it cannot
+/// be evaluated).
+type Contribution<'a> = dyn Fn(&BTreeMap<String, f64>) -> Option<Vec<f64>> + 'a;
+
 /// Per row, the derivative of `f` in each parameter of `params` that
 /// `keep` lets through, by a forward difference, in deg/s (`per_dps` of
 /// `f`'s unit make a deg/s: 3600 for deg/h), each mapped by `map`.
 fn derivatives(
     params: &BTreeMap<String, f64>,
-    f: &dyn Fn(&BTreeMap<String, f64>) -> Option<Vec<f64>>,
+    f: &Contribution,
     (keep, per_dps): (&dyn Fn(&str) -> bool, f64),
     map: &dyn Fn(&[f64]) -> Vec<f64>,
 ) -> Vec<Vec<f64>> {
