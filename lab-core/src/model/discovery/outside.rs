@@ -174,11 +174,9 @@ fn jointly(
     m3.terms.truncate(users);
     m3.terms.extend(ts);
     let again = discover_library(&m3, run, opts);
-    // The coefficients moved, not what the library names: a name the
-    // joint fit brings in is one the terms' coefficients make room for.
-    let names = |d: &Discovery| -> Vec<Effect> { d.found.iter().map(|f| f.effect).collect() };
-    let (was, now) = (names(&next), names(&again));
-    if again.gap_after_dph < next.gap_after_dph && now.iter().all(|e| was.contains(e)) {
+    // A name the library brings in beside them is asked by `prune`, as
+    // every name beside a term is.
+    if again.gap_after_dph < next.gap_after_dph {
         (m3, again)
     } else {
         (m2, next)
