@@ -86,6 +86,10 @@ pub fn centre(run: &Run, mut d: Discovery, window_s: f64) -> Discovery {
     if moved {
         d.residual_after.iter_mut().for_each(|r| *r -= mean);
         d.gap_after_dph = gap(&d.gap_windows, &d.residual_after);
+        // What stands above the noise is part of the gap, centred too.
+        if let Some(u) = d.unexplained.as_mut() {
+            u.excess_dph = u.excess_dph.min(d.gap_after_dph);
+        }
         // Centred twice (each library run the search compared, then the
         // result): the moves add.
         d.centred_by_dph += by;

@@ -137,7 +137,20 @@ pub fn jointly_linear(
     if cols.is_empty() || cols.len() != which.len() {
         return None;
     }
-    let cols: Vec<Vec<f64>> = cols.into_iter().map(|c| orthogonal(c, &q)).collect();
+    // A column the carried ones (nearly) hold, a term linear in what the
+    // library names beside it, is round-off once they are taken out: its
+    // step would be noise, so there is none.
+    let mut out_cols = vec![];
+    for c in cols {
+        let was = dot(&c, &c);
+        let o = orthogonal(c, &q);
+        let kept = dot(&o, &o);
+        if kept.is_nan() || kept <= 1e-12 * was {
+            return None;
+        }
+        out_cols.push(o);
+    }
+    let cols = out_cols;
     let y = orthogonal(map(&d.residual_after), &q);
     let step = normal_solve(&cols, &y)?;
     if step.iter().any(|s| !s.is_finite()) || step.iter().all(|s| *s == 0.0) {
