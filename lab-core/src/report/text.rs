@@ -23,6 +23,17 @@ pub fn num(x: f64) -> String {
     }
 }
 
+/// A time in seconds, to 0.1 s however far from zero: a device clock's
+/// seconds since power-on run to 1e8 and more, where six significant
+/// digits would make every span of a record the same.
+pub fn time_s(t: f64) -> String {
+    if t.is_finite() && t.abs() >= 1e4 {
+        format!("{t:.1}")
+    } else {
+        sig(t)
+    }
+}
+
 /// A measured quantity to 6 significant digits, trailing zeros dropped
 /// (0.0020000000000000018 s prints as 0.002).
 pub fn sig(x: f64) -> String {

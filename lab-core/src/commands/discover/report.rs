@@ -8,7 +8,7 @@ use crate::model::effects::Effect;
 use crate::noise::terms;
 use crate::report::document::Report;
 use crate::report::plot::{Axes, Series};
-use crate::report::text::{num, sig};
+use crate::report::text::{num, sig, time_s};
 use crate::report::verdict::Verdict;
 
 const DPH: f64 = 3600.0;
@@ -53,7 +53,7 @@ fn residual_section(r: &mut Report, d: &Discovery) {
         let rows: Vec<Vec<String>> = d
             .disagreements
             .iter()
-            .map(|s| vec![sig(s.from_s), sig(s.to_s), num(s.peak_dph)])
+            .map(|s| vec![time_s(s.from_s), time_s(s.to_s), num(s.peak_dph)])
             .collect();
         r.table(
             &["from, s", "to, s", "peak residual (60 s mean), deg/h"],
@@ -319,7 +319,7 @@ fn unexplained_section(r: &mut Report, d: &Discovery) {
         let rows: Vec<Vec<String>> = u
             .spans
             .iter()
-            .map(|s| vec![sig(s.from_s), sig(s.to_s), num(s.peak_dph)])
+            .map(|s| vec![time_s(s.from_s), time_s(s.to_s), num(s.peak_dph)])
             .collect();
         r.table(
             &[
@@ -527,8 +527,8 @@ fn verdict(d: &Discovery) -> Verdict {
                 v.text(&format!(
                     ", in {} span(s) from {} s to {} s",
                     u.spans.len(),
-                    sig(a.from_s),
-                    sig(b.to_s)
+                    time_s(a.from_s),
+                    time_s(b.to_s)
                 ));
             }
             if let Some(c) = u.correlates.first() {
