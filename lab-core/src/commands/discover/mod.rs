@@ -45,6 +45,10 @@ pub struct Validation {
     pub discovery: Discovery,
     /// Each named term, with and without it on that run.
     pub terms: Vec<SecondRun>,
+    /// The gap the model written leaves there with its bias alone
+    /// refitted (the 1 s means less their mean): what it predicts of a
+    /// run it was not fitted on, up to a bias.
+    pub bias_removed_dph: f64,
 }
 
 /// What `discover` found.
@@ -143,6 +147,7 @@ pub fn discover_run(req: Request) -> Result<DiscoverOutcome, LabError> {
                 name: src.name(),
                 discovery: discover_library(&d.model_after, &v, &opts_v),
                 terms,
+                bias_removed_dph: bias_removed_gap(&d.model_after, &v),
             })
         }
         None => None,
@@ -164,6 +169,7 @@ impl DiscoverOutcome {
         let mut j = json(&self.d);
         if let Some(v) = &self.validation {
             j["validation"] = validation_json(&v.name, &v.discovery);
+            j["validation"]["gap_bias_removed_dph"] = v.bias_removed_dph.into();
             let mut k = 0;
             for f in j["found"].as_array_mut().into_iter().flatten() {
                 if f["effect"] == "term" {
@@ -186,6 +192,10 @@ impl DiscoverOutcome {
         out.extend(text::lines(&self.name, d, written));
         if let Some(v) = &self.validation {
             out.push(validation_text(&v.name, &v.discovery));
+            out.push(format!(
+                "  as written, its bias alone refitted, the model leaves {:.4} deg/h on {}",
+                v.bias_removed_dph, v.name
+            ));
             for (t, s) in d
                 .terms
                 .iter()
@@ -294,16 +304,20 @@ impl SecondRun {
 }
 
 /// [`SecondRun`] of each named term of `d`'s model on `v`.
-fn second_run_terms(d: &Discovery, v: &Run) -> Vec<SecondRun> {
+/// The gap `m` leaves on `v` up to a bias: the RMS of the 1 s means of
+/// its residual less their mean, deg/h.
+fn bias_removed_gap(m: &Model, v: &Run) -> f64 {
     let win = crate::model::discovery::windows::Windows::new(&v.inputs.t, WINDOW_S);
-    let gap = |m: &Model| -> f64 {
-        let sim = m.evaluate(&v.inputs);
-        let r: Vec<f64> = v.rate.iter().zip(&sim).map(|(a, b)| a - b).collect();
-        let w = win.mean(&r);
-        let n = w.len().max(1) as f64;
-        let mean = w.iter().sum::<f64>() / n;
-        (w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() * 3600.0
-    };
+    let sim = m.evaluate(&v.inputs);
+    let r: Vec<f64> = v.rate.iter().zip(&sim).map(|(a, b)| a - b).collect();
+    let w = win.mean(&r);
+    let n = w.len().max(1) as f64;
+    let mean = w.iter().sum::<f64>() / n;
+    (w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() * 3600.0
+}
+
+fn second_run_terms(d: &Discovery, v: &Run) -> Vec<SecondRun> {
+    let gap = |m: &Model| bias_removed_gap(m, v);
     let with = gap(&d.model_after);
     d.terms
         .iter()

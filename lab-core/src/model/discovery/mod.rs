@@ -30,6 +30,7 @@ pub mod noise_model;
 pub mod normal;
 pub mod outside;
 pub mod projection;
+pub mod restart;
 pub mod result;
 pub mod select;
 pub mod terms;
@@ -455,12 +456,22 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
     // closed 5 % of the excess uncentred, 62 % centred).
     let library =
         |m: &Model, r: &Run, o: &Options| centre::centre(r, discover_library(m, r, o), WINDOW_S);
-    let first = library(model, run, opts);
-    centre::centre(
-        run,
-        outside::beyond(model, run, opts, first, &library),
-        WINDOW_S,
-    )
+    let whole = |o: &Options| {
+        let first = library(model, run, o);
+        let warm = restart::names_warm_up(model, &first);
+        let d = centre::centre(
+            run,
+            outside::beyond(model, run, o, first, &library),
+            WINDOW_S,
+        );
+        (d, warm)
+    };
+    let (main, warm) = whole(opts);
+    if !warm {
+        return main;
+    }
+    let (alt, _) = whole(&restart::without_warm_up(opts));
+    restart::better(model, main, alt)
 }
 
 /// [`discover`] with the library's effects alone (the model's terms held
