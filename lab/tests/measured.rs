@@ -200,5 +200,9 @@ fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
         .collect();
     eprintln!("found {found:?}; gap after {after:.1} deg/h, least-squares cubic {cubic:.1}");
     assert!(!found.contains(&"warm_up"), "{found:?}");
+    assert!(found.contains(&"bias_temperature"), "{found:?}");
     assert!(after < cubic, "{after} against the cubic's {cubic}");
+    // The warm-up was the first start's, and is said to have gone.
+    let dropped = j["dropped"].to_string();
+    assert!(dropped.contains("warm_up"), "{dropped}");
 }

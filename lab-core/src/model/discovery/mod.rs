@@ -467,7 +467,7 @@ pub fn discover(model: &Model, run: &Run, opts: &Options) -> Discovery {
         (d, warm)
     };
     let (main, warm) = whole(opts);
-    if !warm {
+    if !warm || !restart::worth_another(&main) {
         return main;
     }
     let (alt, _) = whole(&restart::without_warm_up(opts));

@@ -307,8 +307,23 @@ fn prune(
                     // Refitted: a second part left at zero is the term.
                     let t3 = &m3.terms[users + k].params;
                     if ok && t3.get("k2_dph").is_some_and(|&x| x != 0.0) && second.plausible(t3) {
+                        // The variant must predict blocks of the record it
+                        // was not fitted on, as the plain term did, by the
+                        // space's threshold (the search validated the plain
+                        // term, not it).
+                        let i = users + k;
+                        let free = free_params(&d3.model_after.terms[i], true, &run.inputs);
+                        let thr = meta[k].2.threshold;
+                        let Some(mut val) = refit(given, &d3, run, i, &free).map(|f| f.validation)
+                        else {
+                            continue;
+                        };
+                        if val.held_out_gain.is_nan() || val.held_out_gain < thr {
+                            continue;
+                        }
+                        val.threshold = val.threshold.max(thr);
                         (saves, drop) = (s3, true);
-                        chosen = Some((m3, d3, Some((k, label.clone()))));
+                        chosen = Some((m3, d3, Some((k, label.clone(), val))));
                         break 'variants;
                     }
                 }
@@ -316,7 +331,7 @@ fn prune(
         }
         if let (true, Some((m2, d, relabel))) = (drop, chosen) {
             let by = match &relabel {
-                Some((_, l)) => format!("the proposed term as {l}"),
+                Some((_, l, _)) => format!("the proposed term as {l}"),
                 None => "the proposed term".into(),
             };
             pruned.push(format!(
@@ -325,8 +340,9 @@ fn prune(
                 saves,
                 asks
             ));
-            if let Some((k, l)) = relabel {
+            if let Some((k, l, val)) = relabel {
                 meta[k].0 = l;
+                meta[k].2 = val;
                 replaced[k] = true;
             }
             (m, cur, o) = (m2, d, o2);
