@@ -206,3 +206,61 @@ fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
     let dropped = j["dropped"].to_string();
     assert!(dropped.contains("warm_up"), "{dropped}");
 }
+
+/// The sweep's second half (warming 18 -> 74 degC, cooling to 36): a
+/// sinusoid in time is proposed beside the temperature's terms, and a
+/// square in temperature predicted the record as well. A shape of time
+/// alone carries to no other run: the term says what it could not be
+/// told from.
+#[test]
+fn a_shape_of_time_says_which_input_term_predicted_as_well() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/measured/tofupilot_imu_thermal/imu_raw_data.csv");
+    let r: Vec<(f64, f64, f64)> = rows(&data).into_iter().skip(4200).collect();
+    let d = dir("measured-chamber-second-half");
+    let file = d.join("second_half.csv");
+    let t0 = r[0].0;
+    let mut text = String::from("t_s,rate_dps,temp_c\n");
+    for (t, w, c) in &r {
+        text.push_str(&format!("{},{},{c}\n", t - t0, w / 3600.0));
+    }
+    std::fs::write(&file, text).unwrap();
+    let out = lab_ok(&[
+        "discover",
+        "--gyro",
+        "mems",
+        "--data",
+        file.to_str().unwrap(),
+        "--out",
+        d.join("out").to_str().unwrap(),
+        "--json",
+        "--force",
+    ]);
+    let j = json(&out);
+    let terms: Vec<&serde_json::Value> = j["found"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["effect"] == "term")
+        .collect();
+    let inputs = ["temp_c", "ref_rate_dps", "ref_acc_dps2"];
+    let of_time: Vec<&&serde_json::Value> = terms
+        .iter()
+        .filter(|f| {
+            let s = f["formula"].as_str().unwrap();
+            !inputs.iter().any(|i| s.contains(i))
+        })
+        .collect();
+    assert!(!of_time.is_empty(), "{terms:?}");
+    for f in of_time {
+        let rival = &f["rival"];
+        let gain = f["validation"]["held_out_gain"].as_f64().unwrap();
+        let rg = rival["held_out_gain"].as_f64().unwrap();
+        assert!(rival["formula"].as_str().unwrap().contains("temp_c"), "{f}");
+        // Within the scatter of the term's own gain (2 sqrt(G)).
+        assert!(
+            rg >= gain - (0.03 * gain).max(2.0 * gain.sqrt()),
+            "{rg} against {gain}"
+        );
+    }
+}

@@ -265,6 +265,12 @@ fn a_missing_rate_squared_term_is_proposed_and_predicts_a_second_run() {
         removed <= 1.25 * floor_b,
         "{removed} against the floor {floor_b}"
     );
+    // ... and within the bar of what run B's own discovery leaves:
+    // the model is the gyro's, not run A's.
+    let ratio = vb["prediction_ratio"].as_f64().unwrap();
+    let own = vb["own_gap_after_dph"].as_f64().unwrap();
+    assert!((removed / own - ratio).abs() < 1e-12, "{ratio}");
+    assert!(ratio <= 1.1, "{removed} against run B's own {own}");
 }
 
 /// Coloured noise alone (flicker and a rate random walk, the usual

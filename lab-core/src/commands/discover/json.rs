@@ -49,6 +49,9 @@ fn term_json(t: &TermFound) -> serde_json::Value {
             "units": "noise variances of the whitened residual",
         },
         "disguise": t.disguise,
+        "rival": t.rival.as_ref().map(|r| serde_json::json!({
+            "label": r.label, "formula": r.formula, "held_out_gain": r.held_out_gain,
+        })),
         "gap_closed": t.closure.map(|c| serde_json::json!({
             "gap_without_dph": c.0, "gap_with_dph": c.1, "excess_closed_share": c.2,
         })),

@@ -49,6 +49,9 @@ pub struct Validation {
     /// refitted (the 1 s means less their mean): what it predicts of a
     /// run it was not fitted on, up to a bias.
     pub bias_removed_dph: f64,
+    /// The gap that run's own discovery leaves, from the model given:
+    /// what one run's model is held against on another.
+    pub own_dph: f64,
 }
 
 /// What `discover` found.
@@ -148,6 +151,7 @@ pub fn discover_run(req: Request) -> Result<DiscoverOutcome, LabError> {
                 discovery: discover_library(&d.model_after, &v, &opts_v),
                 terms,
                 bias_removed_dph: bias_removed_gap(&d.model_after, &v),
+                own_dph: discover(&model, &v, &opts).gap_after_dph,
             })
         }
         None => None,
@@ -170,6 +174,8 @@ impl DiscoverOutcome {
         if let Some(v) = &self.validation {
             j["validation"] = validation_json(&v.name, &v.discovery);
             j["validation"]["gap_bias_removed_dph"] = v.bias_removed_dph.into();
+            j["validation"]["own_gap_after_dph"] = v.own_dph.into();
+            j["validation"]["prediction_ratio"] = (v.bias_removed_dph / v.own_dph).into();
             let mut k = 0;
             for f in j["found"].as_array_mut().into_iter().flatten() {
                 if f["effect"] == "term" {
@@ -193,8 +199,11 @@ impl DiscoverOutcome {
         if let Some(v) = &self.validation {
             out.push(validation_text(&v.name, &v.discovery));
             out.push(format!(
-                "  as written, its bias alone refitted, the model leaves {:.4} deg/h on {}",
-                v.bias_removed_dph, v.name
+                "  as written, its bias alone refitted, the model leaves {:.4} deg/h on {}; that run's own discovery leaves {:.4}: {:.3} times it",
+                v.bias_removed_dph,
+                v.name,
+                v.own_dph,
+                v.bias_removed_dph / v.own_dph
             ));
             for (t, s) in d
                 .terms

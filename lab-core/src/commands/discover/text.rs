@@ -74,7 +74,7 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
         let ps = term_params_text(t);
         match &t.carried {
             None => out.push(format!(
-                "{} {} ({}): {ps}; it predicts blocks of the record it was not fitted on by {:.1} noise variances (threshold {}, {} folds){}",
+                "{} {} ({}): {ps}; it predicts blocks of the record it was not fitted on by {:.1} noise variances (threshold {:.1}, {} folds){}",
                 if t.proposed { "found term, a proposal outside the physics library:" } else { "fitted term written in the model:" },
                 t.term.formula,
                 t.label,
@@ -84,6 +84,9 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
                 t.disguise.as_ref().map_or(String::new(), |g| format!("; it is {g}"))
             )),
             Some(why) => out.push(format!("carried term {}: {ps} ({why})", t.term.formula)),
+        }
+        if let Some(r) = &t.rival {
+            out.push(format!("  {}", rival_text(&t.term.formula, r)));
         }
     }
     if let Some(n) = &d.proposals.note {
@@ -182,4 +185,12 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
         written.map_or(String::new(), |w| format!("; written {w}"))
     ));
     out
+}
+
+/// What a shape of time alone could not be told from, said plainly.
+pub fn rival_text(formula: &str, r: &crate::model::proposal::Tried) -> String {
+    format!(
+        "{formula} is a shape of time alone: {} ({}) predicts this record as well (held-out gain {:.1}, within the scatter of the term's); a shape of time carries to no other run, so a second run (--validate) tells them apart",
+        r.label, r.formula, r.held_out_gain
+    )
 }

@@ -497,6 +497,9 @@ pub fn beyond(
     };
     // Proposals: what they were, with their validation.
     let mut proposed: Vec<ProposedMeta> = vec![];
+    // Beside each: the input-built candidate a shape of time alone could
+    // not be told from.
+    let mut rivals: Vec<Option<crate::model::proposal::Tried>> = vec![];
     let mut variants: Vec<Vec<Variant>> = vec![];
     let mut log = Proposals::default();
     // Per proposed term: the gap after without and with it, and the share
@@ -636,6 +639,7 @@ pub fn beyond(
         };
         closure.push((cur.gap_after_dph, next.gap_after_dph, closed));
         proposed.push((pr.label.clone(), pr.intervals, pr.validation));
+        rivals.push(pr.rival);
         variants.push(pr.variants);
         (m, cur) = (m2, next);
     }
@@ -732,6 +736,11 @@ pub fn beyond(
             carried,
             disguise,
             closure: is_proposed.then(|| closure[i - users]),
+            rival: if is_proposed {
+                rivals[i - users].clone()
+            } else {
+                None
+            },
         });
     }
     let mut out = cur;

@@ -157,6 +157,9 @@ pub struct TermFound {
     /// A proposed term's effect on the gap after: without it, with it
     /// (deg/h), and the share of the excess over the floor it closed.
     pub closure: Option<(f64, f64, f64)>,
+    /// A proposed shape of time alone: the candidate built from the run's
+    /// inputs that predicted as much of the record (proposal/mod.rs).
+    pub rival: Option<Tried>,
 }
 
 /// What the proposal tried on the run (the last attempt), and why it

@@ -96,7 +96,7 @@ impl Prim {
         }
     }
 
-    fn is_input(&self) -> bool {
+    pub fn is_input(&self) -> bool {
         self.kind == PrimKind::Input
     }
 }

@@ -47,6 +47,11 @@ pub struct Proposed {
     /// two, and its coefficient, from their joint fit).
     pub intervals: BTreeMap<String, (f64, f64)>,
     pub validation: Validation,
+    /// Where the term is a shape of time alone: the best candidate built
+    /// from the run's inputs that the data could not tell from it by
+    /// held-out gain. A shape of time carries to no other run; a second
+    /// run tells the two apart.
+    pub rival: Option<Tried>,
     /// The same term with a second part beside it (candidates.rs's
     /// `paired`: its lead, its square, or the lagged input direct), its label and the
     /// term at the proposed values with the second coefficient at zero.
@@ -276,9 +281,28 @@ pub fn propose(
     // Where every finalist was a pair that did not stay what it stands
     // for, and it had set the margin, the choice again without the pairs.
     let chosen = choose(&|_| true).or_else(|| choose(&|s| s.0.second.is_none()));
+    // A shape of time alone (an event, a sinusoid, a ramp: no input in its
+    // recipe) and the best input-built candidate within its gain's scatter.
+    let of_time = |c: &Candidate| c.recipe.iter().all(|f| !prims[f.prim].is_input());
+    let rival = |s: &Scored| -> Option<Tried> {
+        if !of_time(&s.0) {
+            return None;
+        }
+        let margin = (0.03 * s.3).max(2.0 * (s.3 / var).max(0.0).sqrt() * var);
+        scored
+            .iter()
+            .filter(|r| !of_time(&r.0) && r.3 >= s.3 - margin && r.3 / var >= thr)
+            .max_by(|a, b| a.3.total_cmp(&b.3))
+            .map(|r| Tried {
+                label: r.0.label.clone(),
+                formula: r.0.formula(),
+                held_out_gain: r.3 / var,
+            })
+    };
     let proposed = chosen.map(|(s, (term, intervals, _))| {
         let (gain, folds) = (s.3, &s.4);
         Proposed {
+            rival: rival(s),
             label: s.0.label.clone(),
             variants: variants(&s.0, &term, &paired),
             term,
