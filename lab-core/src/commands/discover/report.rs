@@ -256,8 +256,8 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
         if let Some(g) = &t.disguise {
             r.note(&format!("A known shape in disguise: this term is {g}."));
         }
-        if let Some(x) = &t.rival {
-            r.note(&format!("{}.", super::text::rival_text(&t.term.formula, x)));
+        if let Some(x) = t.rival_text() {
+            r.note(&format!("{x}."));
         }
         let Ok(c) = t.term.evaluate(&run.inputs) else {
             continue;

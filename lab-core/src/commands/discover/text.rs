@@ -85,8 +85,8 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
             )),
             Some(why) => out.push(format!("carried term {}: {ps} ({why})", t.term.formula)),
         }
-        if let Some(r) = &t.rival {
-            out.push(format!("  {}", rival_text(&t.term.formula, r)));
+        if let Some(r) = t.rival_text() {
+            out.push(format!("  {r}"));
         }
     }
     if let Some(n) = &d.proposals.note {
@@ -185,12 +185,4 @@ pub(super) fn lines(name: &str, d: &Discovery, written: Option<&str>) -> Vec<Str
         written.map_or(String::new(), |w| format!("; written {w}"))
     ));
     out
-}
-
-/// What a shape of time alone could not be told from, said plainly.
-pub fn rival_text(formula: &str, r: &crate::model::proposal::Tried) -> String {
-    format!(
-        "{formula} is a shape of time alone: {} ({}) predicts this record as well (held-out gain {:.1}, within the scatter of the term's); a shape of time carries to no other run, so a second run (--validate) tells them apart",
-        r.label, r.formula, r.held_out_gain
-    )
 }

@@ -162,6 +162,16 @@ pub struct TermFound {
     pub rival: Option<Tried>,
 }
 
+impl TermFound {
+    /// What a shape of time alone could not be told from, said plainly.
+    pub fn rival_text(&self) -> Option<String> {
+        self.rival.as_ref().map(|r| format!(
+            "{} is a shape of time alone: {} ({}) predicts this record as well (held-out gain {:.1}, within the scatter of the term's); a shape of time carries to no other run, so a second run (--validate) tells them apart",
+            self.term.formula, r.label, r.formula, r.held_out_gain
+        ))
+    }
+}
+
 /// What the proposal tried on the run (the last attempt), and why it
 /// stopped where it did.
 #[derive(Clone, Debug, Default)]
