@@ -155,19 +155,20 @@ fn a_mems_gyro_swept_in_a_chamber_is_explained_as_the_best_cubic_in_temperature(
     assert!(lo <= 0.0 && 0.0 <= hi, "{lo} .. {hi}");
 }
 
-/// The sweep's first half (cooling from 52 to -18 degC and warming back
-/// to 18), as a user's converted file whose clock starts at zero: a
-/// warm-up from that zero fits the first fall of a bias that follows the
-/// temperature, and taken first it leaves the rest to a random walk
-/// (restart.rs). The bias follows the temperature: no warm-up is named,
-/// and the model leaves less than the least-squares cubic in temperature.
-#[test]
-fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
+/// The record's rows `from..to` as a user's converted file, its clock from
+/// zero (t_s, rate_dps, temp_c), discovered as a MEMS gyro: the rows and
+/// the JSON.
+fn discover_part(name: &str, from: usize, to: usize) -> (Vec<(f64, f64, f64)>, serde_json::Value) {
     let data = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/measured/tofupilot_imu_thermal/imu_raw_data.csv");
-    let r: Vec<(f64, f64, f64)> = rows(&data).into_iter().take(4200).collect();
-    let d = dir("measured-chamber-half");
-    let file = d.join("first_half.csv");
+    let all = rows(&data);
+    let t0 = all[from].0;
+    let r: Vec<(f64, f64, f64)> = all[from..to.min(all.len())]
+        .iter()
+        .map(|x| (x.0 - t0, x.1, x.2))
+        .collect();
+    let d = dir(name);
+    let file = d.join("part.csv");
     let mut text = String::from("t_s,rate_dps,temp_c\n");
     for (t, w, c) in &r {
         text.push_str(&format!("{t},{},{c}\n", w / 3600.0));
@@ -184,7 +185,18 @@ fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
         "--json",
         "--force",
     ]);
-    let j = json(&out);
+    (r, json(&out))
+}
+
+/// The sweep's first half (cooling from 52 to -18 degC and warming back
+/// to 18), as a user's converted file whose clock starts at zero: a
+/// warm-up from that zero fits the first fall of a bias that follows the
+/// temperature, and taken first it leaves the rest to a random walk
+/// (restart.rs). The bias follows the temperature: no warm-up is named,
+/// and the model leaves less than the least-squares cubic in temperature.
+#[test]
+fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
+    let (r, j) = discover_part("measured-chamber-half", 0, 4200);
     let t: Vec<f64> = r.iter().map(|x| x.0).collect();
     let y: Vec<f64> = r.iter().map(|x| x.1).collect();
     let x: Vec<Vec<f64>> = (0..=3)
@@ -214,29 +226,7 @@ fn a_chamber_sweep_starting_hot_is_not_read_as_a_warm_up() {
 /// told from.
 #[test]
 fn a_shape_of_time_says_which_input_term_predicted_as_well() {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/measured/tofupilot_imu_thermal/imu_raw_data.csv");
-    let r: Vec<(f64, f64, f64)> = rows(&data).into_iter().skip(4200).collect();
-    let d = dir("measured-chamber-second-half");
-    let file = d.join("second_half.csv");
-    let t0 = r[0].0;
-    let mut text = String::from("t_s,rate_dps,temp_c\n");
-    for (t, w, c) in &r {
-        text.push_str(&format!("{},{},{c}\n", t - t0, w / 3600.0));
-    }
-    std::fs::write(&file, text).unwrap();
-    let out = lab_ok(&[
-        "discover",
-        "--gyro",
-        "mems",
-        "--data",
-        file.to_str().unwrap(),
-        "--out",
-        d.join("out").to_str().unwrap(),
-        "--json",
-        "--force",
-    ]);
-    let j = json(&out);
+    let (_, j) = discover_part("measured-chamber-second-half", 4200, usize::MAX);
     let terms: Vec<&serde_json::Value> = j["found"]
         .as_array()
         .unwrap()
