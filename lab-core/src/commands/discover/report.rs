@@ -29,23 +29,45 @@ fn thin(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The plots' time axis: the run's clock, or, where it reads a device's
+/// clock far from zero (a record starting 2.6e8 s after its epoch), the
+/// time since the record's first row, the clock's start said in the label.
+fn time_axis(t: &[f64]) -> (Vec<f64>, String) {
+    let (t0, t1) = (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(0.0),
+    );
+    if t0 > 10.0 * (t1 - t0).max(1.0) {
+        (
+            t.iter().map(|x| x - t0).collect(),
+            format!(
+                "time since the record's first window, s (at {} s on its clock)",
+                time_s(t0)
+            ),
+        )
+    } else {
+        (t.to_vec(), "time since power-on, s".into())
+    }
+}
+
 /// The residual over time before and after, and where it disagrees.
 fn residual_section(r: &mut Report, d: &Discovery) {
     let win = &d.gap_windows;
     let before = win.mean(&d.residual_before);
     let after = win.mean(&d.residual_after);
     r.heading("Residual before and after");
+    let (tx, x_label) = time_axis(&win.t);
     r.plot(
         &Axes {
             title: format!("measured - model, {}", gap_means_text(d)),
-            x_label: "time since power-on, s".into(),
+            x_label,
             y_label: "residual, deg/h".into(),
             log_x: false,
             log_y: false,
         },
         &[
-            Series::line("before", thin(&win.t, &scale(&before)), 0),
-            Series::line("after", thin(&win.t, &scale(&after)), 1),
+            Series::line("before", thin(&tx, &scale(&before)), 0),
+            Series::line("after", thin(&tx, &scale(&after)), 1),
         ],
         "The residual averaged over the gap's windows, before and after the found effects were added.",
     );
@@ -265,17 +287,18 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
         let cw: Vec<f64> = win.mean(&c);
         // The residual the term explains: after the model, the term put back.
         let partial: Vec<f64> = after.iter().zip(&cw).map(|(a, b)| a * DPH + b).collect();
+        let (tx, x_label) = time_axis(&win.t);
         r.plot(
             &Axes {
                 title: format!("{}: the term against the residual it explains", t.term.formula),
-                x_label: "time since power-on, s".into(),
+                x_label,
                 y_label: "deg/h".into(),
                 log_x: false,
                 log_y: false,
             },
             &[
-                Series::points("residual with the term put back, 1 s means", thin(&win.t, &partial), None, 0),
-                Series::line("the term", thin(&win.t, &cw), 1),
+                Series::points("residual with the term put back, 1 s means", thin(&tx, &partial), None, 0),
+                Series::line("the term", thin(&tx, &cw), 1),
             ],
             "The residual after the model with this term's contribution added back (points), and the term (line): \
              where the term is what was missing the points scatter about the line by the noise alone.",
@@ -625,5 +648,24 @@ pub fn gap_means_text(d: &Discovery) -> String {
         format!("its rows ({} s each)", sig(w))
     } else {
         format!("{WINDOW_S} s means")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::time_axis;
+
+    #[test]
+    fn a_device_clock_is_plotted_from_the_records_start() {
+        // A record of 70 min stamped on a clock 2.6e8 s from its epoch.
+        let t: Vec<f64> = (0..4200).map(|k| 2.565e8 + k as f64).collect();
+        let (x, label) = time_axis(&t);
+        assert_eq!((x[0], x[4199]), (0.0, 4199.0));
+        assert!(label.contains("256500000.0 s on its clock"), "{label}");
+        // A clock from power-on is the axis as it stands.
+        let t: Vec<f64> = (0..100).map(|k| 5.0 + k as f64).collect();
+        let (x, label) = time_axis(&t);
+        assert_eq!(x, t);
+        assert_eq!(label, "time since power-on, s");
     }
 }
