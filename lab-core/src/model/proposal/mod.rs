@@ -94,6 +94,14 @@ pub struct Tried {
     pub held_out_gain: f64,
 }
 
+/// How far below a held-out gain `g` (a sum of squares; `var`, the noise
+/// variance) another is not told from it: a gain G in noise variances
+/// scatters by about 2 sqrt(G) from one record of the gyro to the next,
+/// and by at least 3 % of itself.
+fn scatter(g: f64, var: f64) -> f64 {
+    (0.03 * g).max(2.0 * (g / var).max(0.0).sqrt() * var)
+}
+
 /// The outcome: the term proposed (none when no candidate predicts beyond
 /// the threshold), and every candidate's score, best first.
 #[derive(Clone, Debug, PartialEq)]
@@ -247,7 +255,7 @@ pub fn propose(
             .filter(|s| pool(s))
             .map(|s| s.3)
             .fold(f64::NEG_INFINITY, f64::max);
-        let margin = (0.03 * top).max(2.0 * (top / var).max(0.0).sqrt() * var);
+        let margin = scatter(top, var);
         let mut finalists: Vec<&Scored> = scored
             .iter()
             .filter(|s| pool(s) && s.3 >= top - margin && s.3 / var >= thr)
@@ -288,7 +296,7 @@ pub fn propose(
         if !of_time(&s.0) {
             return None;
         }
-        let margin = (0.03 * s.3).max(2.0 * (s.3 / var).max(0.0).sqrt() * var);
+        let margin = scatter(s.3, var);
         scored
             .iter()
             .filter(|r| !of_time(&r.0) && r.3 >= s.3 - margin && r.3 / var >= thr)
