@@ -312,7 +312,6 @@ impl SecondRun {
     }
 }
 
-/// [`SecondRun`] of each named term of `d`'s model on `v`.
 /// The gap `m` leaves on `v` up to a bias: the RMS of the 1 s means of
 /// its residual less their mean, deg/h.
 fn bias_removed_gap(m: &Model, v: &Run) -> f64 {
@@ -325,6 +324,7 @@ fn bias_removed_gap(m: &Model, v: &Run) -> f64 {
     (w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() * 3600.0
 }
 
+/// [`SecondRun`] of each named term of `d`'s model on `v`.
 fn second_run_terms(d: &Discovery, v: &Run) -> Vec<SecondRun> {
     let gap = |m: &Model| bias_removed_gap(m, v);
     let with = gap(&d.model_after);

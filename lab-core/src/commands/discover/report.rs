@@ -227,6 +227,8 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
     }
     let win = &d.windows;
     let after = win.mean(&d.residual_after);
+    // The time axis every term is plotted against.
+    let (tx, x_label) = time_axis(&win.t);
     for t in &d.terms {
         let what = if t.proposed {
             format!(
@@ -287,11 +289,10 @@ fn terms_section(r: &mut Report, d: &Discovery, run: &Run) {
         let cw: Vec<f64> = win.mean(&c);
         // The residual the term explains: after the model, the term put back.
         let partial: Vec<f64> = after.iter().zip(&cw).map(|(a, b)| a * DPH + b).collect();
-        let (tx, x_label) = time_axis(&win.t);
         r.plot(
             &Axes {
                 title: format!("{}: the term against the residual it explains", t.term.formula),
-                x_label,
+                x_label: x_label.clone(),
                 y_label: "deg/h".into(),
                 log_x: false,
                 log_y: false,

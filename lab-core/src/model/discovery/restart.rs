@@ -11,8 +11,9 @@
 //! leaves something unexplained, it is run again with the warm-up out of
 //! the library, and the start kept is the one whose model leaves the
 //! smaller gap by more than the criterion asks (the names' threshold of
-//! 10, plus ln n per parameter it adds, as the pruning of names asks). A warm-up the record holds is kept: no
-//! start without it closes as much.
+//! 10, plus ln n per parameter it adds, as the pruning of names asks).
+//! A warm-up the record holds is kept: no start without it closes as
+//! much.
 
 use super::result::{Discovery, Options};
 use super::select::THRESHOLD as NAME_THRESHOLD;
